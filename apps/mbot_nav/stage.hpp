@@ -1,0 +1,49 @@
+// The pipeline's building block: a stage consumes the event stream and writes its outputs at the
+// end. Stage types are registered by name; the INI names the stages and their options.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mbot/drivers/events.hpp"
+#include "mbot/drivers/source.hpp"
+
+namespace mbot::config {
+class Section;
+}
+
+namespace mbot::app {
+
+struct RunContext {
+  std::string output_dir;     // exists when stages start
+  uint64_t seed = 0;          // the one seed all randomness derives from
+  const drivers::Source* source = nullptr;
+  std::string source_path;
+};
+
+class Stage {
+ public:
+  virtual ~Stage() = default;
+  // Called once before the first event (open outputs here, not in the constructor).
+  virtual void Start(const RunContext& /*context*/) {}
+  virtual void OnEvent(const drivers::Event& event) = 0;
+  // Called once at the end, also after Ctrl-C (interrupted = true): write what was computed.
+  virtual void Finish(const RunContext& context, bool interrupted) = 0;
+};
+
+// A stage type: its factory parses the stage's section (strictly) and builds the stage without
+// touching any file. Called with a describe-mode section it documents the keys (--list-stages).
+struct StageType {
+  std::string name;
+  std::string doc;
+  std::function<std::unique_ptr<Stage>(config::Section&)> create;
+};
+
+// All registered stage types, sorted by name.
+const std::vector<StageType>& StageTypes();
+const StageType* FindStageType(const std::string& name);
+
+}  // namespace mbot::app

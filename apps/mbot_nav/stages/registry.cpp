@@ -1,0 +1,23 @@
+#include <algorithm>
+
+#include "stages.hpp"
+
+namespace mbot::app {
+
+const std::vector<StageType>& StageTypes() {
+  static const std::vector<StageType> types = [] {
+    std::vector<StageType> t = {InspectStageType(), TrajectoryWriterStageType(), MapWriterStageType()};
+    std::sort(t.begin(), t.end(), [](const StageType& a, const StageType& b) { return a.name < b.name; });
+    return t;
+  }();
+  return types;
+}
+
+const StageType* FindStageType(const std::string& name) {
+  for (const auto& t : StageTypes()) {
+    if (t.name == name) return &t;
+  }
+  return nullptr;
+}
+
+}  // namespace mbot::app

@@ -1,0 +1,12 @@
+// The stage types this application registers (one function per stage file).
+#pragma once
+
+#include "../stage.hpp"
+
+namespace mbot::app {
+
+StageType InspectStageType();
+StageType TrajectoryWriterStageType();
+StageType MapWriterStageType();
+
+}  // namespace mbot::app

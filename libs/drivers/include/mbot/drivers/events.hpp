@@ -1,0 +1,75 @@
+// The project's own event types: what every source (LCM log, live LCM, MRPT rawlog, CARMEN log,
+// map file, simulator) turns its input into. Times are microseconds on the data's clock.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "mbot/mapping/occupancy_grid.hpp"
+#include "mbot/motion/pose2d.hpp"
+
+namespace mbot::drivers {
+
+struct LidarScan {
+  std::vector<float> ranges_m;          // <= 0 or NaN: no return
+  std::vector<float> angles_rad;        // per beam, in the sensor frame (may run 2π → 0)
+  std::vector<int64_t> beam_times_us;   // per beam when the source has them, else empty
+  std::vector<float> intensities;       // empty when absent
+  float max_range_m = 0.0f;             // 0 when the source does not say
+  // Sensor pose on the robot when the source gives one (rawlogs, CARMEN ROBOTLASER).
+  motion::Pose2D sensor_pose;
+};
+
+struct EncoderTicks {
+  int64_t left_ticks = 0;    // cumulative
+  int64_t right_ticks = 0;
+  int32_t left_delta = 0;    // since the previous message, when the source gives it
+  int32_t right_delta = 0;
+  int64_t delta_time_us = 0; // 0 when the source does not say
+};
+
+struct Imu {
+  double gyro_rad_s[3] = {0, 0, 0};
+  double accel_m_s2[3] = {0, 0, 0};
+  double angles_rpy_rad[3] = {0, 0, 0};  // roll, pitch, yaw
+  bool has_angles = false;
+};
+
+struct MotorCommand {
+  enum class Kind { kVelocity, kPwm, kWheelSpeed };
+  Kind kind = Kind::kVelocity;
+  // kVelocity: a = v [m/s], b = ω [rad/s]; kPwm: a = left, b = right duty in [-1, 1];
+  // kWheelSpeed: a = left, b = right wheel speed [rad/s].
+  double a = 0.0;
+  double b = 0.0;
+};
+
+enum class EventKind {
+  kLidar,          // LidarScan
+  kOdometry,       // Pose2D, the robot's own dead-reckoning
+  kEncoders,       // EncoderTicks
+  kImu,            // Imu
+  kMotorCommand,   // MotorCommand
+  kGroundTruth,    // Pose2D, external measurement (motion capture)
+  kReferencePose,  // Pose2D from another estimator (staff SLAM, corrected CARMEN poses)
+  kMap,            // shared_ptr<const OccupancyGrid>
+  kOther,          // recognised but not used by the pipeline (particles, time sync, status …)
+};
+
+const char* ToString(EventKind kind);
+
+using Payload = std::variant<std::monostate, LidarScan, motion::Pose2D, EncoderTicks, Imu,
+                             MotorCommand, std::shared_ptr<const mapping::OccupancyGrid>>;
+
+struct Event {
+  int64_t t_us = 0;       // event (reception / log) time; the order of the stream
+  int64_t stamp_us = 0;   // the message's own timestamp when it has one (may use another clock)
+  std::string channel;
+  EventKind kind = EventKind::kOther;
+  Payload payload;
+};
+
+}  // namespace mbot::drivers

@@ -1,0 +1,39 @@
+// Occupancy-grid file formats: botlab `.map`, ROS map_server PGM + YAML, MRPT `.gridmap(.gz)`,
+// Moving AI `.map`, and PNG pictures. Readers throw std::runtime_error naming the file (and line).
+#pragma once
+
+#include <string>
+
+#include "mbot/mapping/occupancy_grid.hpp"
+
+namespace mbot::drivers {
+
+// botlab: "origin_x origin_y width height meters_per_cell", then `height` rows of `width` int8
+// log-odds, row y = 0 first. Lossless round trip.
+mapping::OccupancyGrid ReadBotlabMap(const std::string& path);
+void WriteBotlabMap(const mapping::OccupancyGrid& grid, const std::string& path);
+
+// ROS map_server: YAML (image, resolution, origin [x, y, yaw], negate, occupied_thresh,
+// free_thresh, mode) + image, top image row = highest y. Cells are classified with the thresholds
+// as map_server does; occupied and free cells keep a graded log-odds from the pixel value.
+// Written maps use pixel = 127 - log-odds with thresholds that split at log-odds 0, so a
+// botlab grid survives the round trip exactly.
+mapping::OccupancyGrid ReadRosMap(const std::string& yaml_path);
+void WriteRosMap(const mapping::OccupancyGrid& grid, const std::string& yaml_path);
+
+// MRPT COccupancyGridMap2D serialised with CArchive (optionally gzip-compressed). MRPT cells hold
+// the probability of being free; it becomes log-odds of occupancy scaled by 20 and clamped.
+mapping::OccupancyGrid ReadMrptGridmap(const std::string& path);
+
+// Moving AI benchmark map ("type octile", height, width, "map", rows; (0,0) top-left). Passable
+// terrain ('.', 'G', 'S') becomes free (-127), everything else occupied (127); 1 m cells, with
+// Moving AI row r stored as grid row height-1-r.
+mapping::OccupancyGrid ReadMovingAiMap(const std::string& path);
+
+// A picture for people: occupied dark, free light, unknown grey, graded by log-odds; top = +y.
+void WriteMapPng(const mapping::OccupancyGrid& grid, const std::string& path);
+
+// Reads any of the formats above, chosen by extension and content.
+mapping::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format = nullptr);
+
+}  // namespace mbot::drivers

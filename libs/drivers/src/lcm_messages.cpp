@@ -1,0 +1,405 @@
+#include "lcm_messages.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <map>
+
+#include "maebot/maebot_encoders_t.hpp"
+#include "maebot/maebot_imu_t.hpp"
+#include "maebot/maebot_motor_command_t.hpp"
+#include "mbot_lcm_msgs/exploration_status_t.hpp"
+#include "mbot_lcm_msgs/mbot_encoders_t.hpp"
+#include "mbot_lcm_msgs/mbot_imu_t.hpp"
+#include "mbot_lcm_msgs/mbot_message_received_t.hpp"
+#include "mbot_lcm_msgs/mbot_motor_pwm_t.hpp"
+#include "mbot_lcm_msgs/mbot_motor_vel_t.hpp"
+#include "mbot_lcm_msgs/mbot_slam_reset_t.hpp"
+#include "mbot_lcm_msgs/pose2D_t.hpp"
+#include "mbot_lcm_msgs/slam_status_t.hpp"
+#include "mbot_lcm_msgs/twist2D_t.hpp"
+#include "mbot_legacy/exploration_status_t.hpp"
+#include "mbot_legacy/lidar_t.hpp"
+#include "mbot_legacy/mbot_encoder_t.hpp"
+#include "mbot_legacy/mbot_imu_t.hpp"
+#include "mbot_legacy/mbot_motor_command_t.hpp"
+#include "mbot_legacy/message_received_t.hpp"
+#include "mbot_legacy/occupancy_grid_t.hpp"
+#include "mbot_legacy/particles_t.hpp"
+#include "mbot_legacy/pose_xyt_t.hpp"
+#include "mbot_legacy/robot_path_t.hpp"
+#include "mbot_legacy/timestamp_t.hpp"
+#include "mbot_w23/mbot_state_t.hpp"
+#include "mbot_w23/mbot_system_reset_t.hpp"
+#include "mbot_w23/mbot_wheel_ctrl_t.hpp"
+#include "mbot_w23/occupancy_grid_t.hpp"
+
+namespace mbot::drivers::lcm_adapter {
+int64_t Fingerprint(const uint8_t* data, size_t size);
+
+namespace {
+
+using Decoder = std::function<bool(const std::string& channel, const uint8_t*, size_t, const ChannelRoles&,
+                                   Event*, std::string*)>;
+
+struct Entry {
+  TypeInfo info;
+  Decoder decode;
+};
+
+int32_t ReadI32(const uint8_t* p) {
+  return static_cast<int32_t>((uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | p[3]);
+}
+
+// Checks the int32 count at `offset` against the bytes left, before the generated decoder sizes a
+// vector by it (a corrupt count would otherwise allocate gigabytes or throw).
+bool CheckCount(const uint8_t* data, size_t size, size_t offset, size_t element_bytes, const char* field,
+                std::string* error) {
+  if (size < offset + 4) {
+    *error = "message too short (" + std::to_string(size) + " bytes) to hold " + field;
+    return false;
+  }
+  const int32_t n = ReadI32(data + offset);
+  if (n < 0 || uint64_t(n) * element_bytes > size - offset - 4) {
+    *error = std::string(field) + " = " + std::to_string(n) + " disagrees with the payload (" +
+             std::to_string(size) + " bytes)";
+    return false;
+  }
+  return true;
+}
+
+// Runs the lcm-gen decoder and insists it consumed exactly the payload.
+template <typename T>
+bool DecodeExact(const uint8_t* data, size_t size, T* msg, std::string* error) {
+  int used = -1;
+  try {
+    used = msg->decode(data, 0, static_cast<int>(size));
+  } catch (const std::exception& e) {
+    *error = std::string("decode failed: ") + e.what();
+    return false;
+  }
+  if (used < 0) {
+    *error = "payload shorter than its fields and counts require (" + std::to_string(size) + " bytes)";
+    return false;
+  }
+  if (static_cast<size_t>(used) != size) {
+    *error = "counts account for " + std::to_string(used) + " of " + std::to_string(size) +
+             " payload bytes (array lengths disagree with their count field)";
+    return false;
+  }
+  return true;
+}
+
+bool In(const std::vector<std::string>& list, const std::string& channel) {
+  return std::find(list.begin(), list.end(), channel) != list.end();
+}
+
+bool Finite(double a, double b, double c) { return std::isfinite(a) && std::isfinite(b) && std::isfinite(c); }
+
+template <typename Lidar>
+bool DecodeLidar(const uint8_t* d, size_t n, Event* ev, std::string* err) {
+  if (!CheckCount(d, n, 16, 20, "num_ranges", err)) return false;
+  Lidar m;
+  if (!DecodeExact(d, n, &m, err)) return false;
+  LidarScan scan;
+  scan.ranges_m = std::move(m.ranges);
+  scan.angles_rad = std::move(m.thetas);
+  scan.beam_times_us = std::move(m.times);
+  scan.intensities = std::move(m.intensities);
+  for (float a : scan.angles_rad) {
+    if (!std::isfinite(a)) {
+      *err = "non-finite beam angle";
+      return false;
+    }
+  }
+  ev->kind = EventKind::kLidar;
+  ev->stamp_us = m.utime;
+  ev->payload = std::move(scan);
+  return true;
+}
+
+bool DecodePose(const std::string& channel, const uint8_t* d, size_t n, const ChannelRoles& roles, Event* ev,
+                std::string* err) {
+  mbot_legacy::pose_xyt_t m;
+  if (!DecodeExact(d, n, &m, err)) return false;
+  if (!Finite(m.x, m.y, m.theta)) {
+    *err = "non-finite pose";
+    return false;
+  }
+  ev->stamp_us = m.utime;
+  ev->payload = motion::Pose2D{m.x, m.y, m.theta};
+  if (In(roles.ground_truth, channel)) ev->kind = EventKind::kGroundTruth;
+  else if (In(roles.odometry, channel)) ev->kind = EventKind::kOdometry;
+  else if (In(roles.reference_pose, channel)) ev->kind = EventKind::kReferencePose;
+  else ev->kind = EventKind::kOther;
+  return true;
+}
+
+template <typename Grid>
+bool DecodeGrid(const uint8_t* d, size_t n, size_t count_offset, Event* ev, std::string* err) {
+  if (!CheckCount(d, n, count_offset, 1, "num_cells", err)) return false;
+  Grid m;
+  if (!DecodeExact(d, n, &m, err)) return false;
+  if (m.width < 0 || m.height < 0 || int64_t(m.width) * m.height != m.num_cells ||
+      !(m.meters_per_cell > 0.0f) || !std::isfinite(m.origin_x) || !std::isfinite(m.origin_y)) {
+    *err = "grid " + std::to_string(m.width) + "x" + std::to_string(m.height) + " does not match num_cells " +
+           std::to_string(m.num_cells) + " or has a bad resolution/origin";
+    return false;
+  }
+  auto grid = std::make_shared<mapping::OccupancyGrid>(m.width, m.height, m.meters_per_cell, m.origin_x, m.origin_y);
+  std::copy(m.cells.begin(), m.cells.end(), grid->cells().begin());
+  for (auto& c : grid->cells()) c = std::max<int8_t>(c, -127);  // -128 is outside the log-odds range
+  ev->kind = EventKind::kMap;
+  ev->stamp_us = m.utime;
+  ev->payload = std::shared_ptr<const mapping::OccupancyGrid>(grid);
+  return true;
+}
+
+// A type the pipeline recognises but does not use: validated, counted, not converted.
+template <typename T>
+Decoder Other(size_t count_offset = 0, size_t element_bytes = 0, const char* field = nullptr) {
+  return [=](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+    if (field && !CheckCount(d, n, count_offset, element_bytes, field, err)) return false;
+    T m;
+    if (!DecodeExact(d, n, &m, err)) return false;
+    ev->kind = EventKind::kOther;
+    ev->stamp_us = n >= 16 ? Fingerprint(d + 8, 8) : 0;  // every such type starts with utime
+    return true;
+  };
+}
+
+std::map<int64_t, Entry> BuildTable() {
+  std::map<int64_t, Entry> t;
+  auto add = [&t](int64_t hash, const std::string& type, const std::string& gen, Decoder dec) {
+    auto it = t.find(hash);
+    if (it == t.end()) {
+      t.emplace(hash, Entry{TypeInfo{type, gen}, std::move(dec)});
+    } else {  // same layout in several generations: one decoder, all names
+      if (it->second.info.type.find(type) == std::string::npos) it->second.info.type += "/" + type;
+      if (it->second.info.generation.find(gen) == std::string::npos) it->second.info.generation += ", " + gen;
+    }
+  };
+  const std::string kLegacy = "legacy 2017-2022", kW23 = "W23", kCurrent = "2023+", kMaebot = "Maebot";
+
+  Decoder lidar = [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev,
+                     std::string* err) { return DecodeLidar<mbot_legacy::lidar_t>(d, n, ev, err); };
+  add(mbot_legacy::lidar_t::getHash(), "lidar_t", kLegacy, lidar);
+  add(mbot_legacy::lidar_t::getHash(), "lidar_t", kW23, lidar);
+  add(mbot_legacy::lidar_t::getHash(), "lidar_t", kCurrent, lidar);
+  add(mbot_legacy::lidar_t::getHash(), "rplidar_laser_t", kMaebot, lidar);
+
+  add(mbot_legacy::pose_xyt_t::getHash(), "pose_xyt_t", kLegacy, DecodePose);
+  add(mbot_legacy::pose_xyt_t::getHash(), "odometry_t", kW23, DecodePose);
+  add(mbot_lcm_msgs::pose2D_t::getHash(), "pose2D_t", kCurrent, DecodePose);
+
+  add(mbot_legacy::mbot_encoder_t::getHash(), "mbot_encoder_t", kLegacy,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        mbot_legacy::mbot_encoder_t m;
+        if (!DecodeExact(d, n, &m, err)) return false;
+        ev->kind = EventKind::kEncoders;
+        ev->stamp_us = m.utime;
+        ev->payload = EncoderTicks{m.leftticks, m.rightticks, m.left_delta, m.right_delta, 0};
+        return true;
+      });
+  add(mbot_legacy::mbot_encoder_t::getHash(), "mbot_encoder_t", kW23, nullptr);
+  add(mbot_lcm_msgs::mbot_encoders_t::getHash(), "mbot_encoders_t", kCurrent,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        mbot_lcm_msgs::mbot_encoders_t m;
+        if (!DecodeExact(d, n, &m, err)) return false;
+        ev->kind = EventKind::kEncoders;
+        ev->stamp_us = m.utime;
+        ev->payload = EncoderTicks{m.ticks[0], m.ticks[1], m.delta_ticks[0], m.delta_ticks[1], m.delta_time};
+        return true;
+      });
+  add(maebot::maebot_encoders_t::getHash(), "maebot_encoders_t", kMaebot,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        maebot::maebot_encoders_t m;
+        if (!DecodeExact(d, n, &m, err)) return false;
+        ev->kind = EventKind::kEncoders;
+        ev->stamp_us = m.utime;
+        ev->payload = EncoderTicks{m.left_ticks_total, m.right_ticks_total, 0, 0, 0};
+        return true;
+      });
+
+  add(mbot_legacy::mbot_imu_t::getHash(), "mbot_imu_t", kLegacy,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        mbot_legacy::mbot_imu_t m;
+        if (!DecodeExact(d, n, &m, err)) return false;
+        Imu imu;
+        for (int i = 0; i < 3; ++i) {
+          imu.gyro_rad_s[i] = m.gyro[i];
+          imu.accel_m_s2[i] = m.accel[i];
+          imu.angles_rpy_rad[i] = m.tb_angles[i];
+        }
+        imu.has_angles = true;
+        ev->kind = EventKind::kImu;
+        ev->stamp_us = m.utime;
+        ev->payload = imu;
+        return true;
+      });
+  add(mbot_legacy::mbot_imu_t::getHash(), "mbot_imu_t", kW23, nullptr);
+  add(mbot_lcm_msgs::mbot_imu_t::getHash(), "mbot_imu_t", kCurrent,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        mbot_lcm_msgs::mbot_imu_t m;
+        if (!DecodeExact(d, n, &m, err)) return false;
+        Imu imu;
+        for (int i = 0; i < 3; ++i) {
+          imu.gyro_rad_s[i] = m.gyro[i];
+          imu.accel_m_s2[i] = m.accel[i];
+          imu.angles_rpy_rad[i] = m.angles_rpy[i];
+        }
+        imu.has_angles = true;
+        ev->kind = EventKind::kImu;
+        ev->stamp_us = m.utime;
+        ev->payload = imu;
+        return true;
+      });
+  add(maebot::maebot_imu_t::getHash(), "maebot_imu_t", kMaebot,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        maebot::maebot_imu_t m;
+        if (!DecodeExact(d, n, &m, err)) return false;
+        Imu imu;
+        for (int i = 0; i < 3; ++i) {
+          imu.gyro_rad_s[i] = m.raw_angular_velocity[i];
+          imu.accel_m_s2[i] = m.raw_acceleration[i];
+          imu.angles_rpy_rad[i] = m.raw_orientation[i];
+        }
+        imu.has_angles = true;
+        ev->kind = EventKind::kImu;
+        ev->stamp_us = m.utime;
+        ev->payload = imu;
+        return true;
+      });
+
+  add(mbot_legacy::mbot_motor_command_t::getHash(), "mbot_motor_command_t", kLegacy,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        mbot_legacy::mbot_motor_command_t m;
+        if (!DecodeExact(d, n, &m, err)) return false;
+        ev->kind = EventKind::kMotorCommand;
+        ev->stamp_us = m.utime;
+        ev->payload = MotorCommand{MotorCommand::Kind::kVelocity, m.trans_v, m.angular_v};
+        return true;
+      });
+  add(mbot_legacy::mbot_motor_command_t::getHash(), "mbot_motor_command_t", kW23, nullptr);
+  add(mbot_lcm_msgs::twist2D_t::getHash(), "twist2D_t", kCurrent,
+      [](const std::string& ch, const uint8_t* d, size_t n, const ChannelRoles& roles, Event* ev, std::string* err) {
+        mbot_lcm_msgs::twist2D_t m;
+        if (!DecodeExact(d, n, &m, err)) return false;
+        ev->stamp_us = m.utime;
+        ev->kind = In(roles.velocity_command, ch) ? EventKind::kMotorCommand : EventKind::kOther;
+        ev->payload = MotorCommand{MotorCommand::Kind::kVelocity, m.vx, m.wz};
+        return true;
+      });
+  add(mbot_lcm_msgs::mbot_motor_pwm_t::getHash(), "mbot_motor_pwm_t", kCurrent,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        mbot_lcm_msgs::mbot_motor_pwm_t m;
+        if (!DecodeExact(d, n, &m, err)) return false;
+        ev->kind = EventKind::kMotorCommand;
+        ev->stamp_us = m.utime;
+        ev->payload = MotorCommand{MotorCommand::Kind::kPwm, m.pwm[0], m.pwm[1]};
+        return true;
+      });
+  add(mbot_lcm_msgs::mbot_motor_vel_t::getHash(), "mbot_motor_vel_t", kCurrent,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        mbot_lcm_msgs::mbot_motor_vel_t m;
+        if (!DecodeExact(d, n, &m, err)) return false;
+        ev->kind = EventKind::kOther;  // measured wheel speeds, not a command
+        ev->stamp_us = m.utime;
+        ev->payload = MotorCommand{MotorCommand::Kind::kWheelSpeed, m.velocity[0], m.velocity[1]};
+        return true;
+      });
+  add(maebot::maebot_motor_command_t::getHash(), "maebot_motor_command_t", kMaebot,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        maebot::maebot_motor_command_t m;
+        if (!DecodeExact(d, n, &m, err)) return false;
+        ev->kind = EventKind::kMotorCommand;
+        ev->stamp_us = m.utime;
+        ev->payload = MotorCommand{MotorCommand::Kind::kPwm, m.left_motor_enabled ? m.left_motor_speed : 0.0,
+                                   m.right_motor_enabled ? m.right_motor_speed : 0.0};
+        return true;
+      });
+  add(mbot_w23::mbot_wheel_ctrl_t::getHash(), "mbot_wheel_ctrl_t", kW23,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        mbot_w23::mbot_wheel_ctrl_t m;
+        if (!DecodeExact(d, n, &m, err)) return false;
+        ev->kind = EventKind::kMotorCommand;
+        ev->stamp_us = m.utime;
+        ev->payload = MotorCommand{MotorCommand::Kind::kPwm, m.left_motor_pwm, m.right_motor_pwm};
+        return true;
+      });
+  add(mbot_w23::mbot_state_t::getHash(), "mbot_state_t", kW23,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        mbot_w23::mbot_state_t m;
+        if (!DecodeExact(d, n, &m, err)) return false;
+        ev->kind = EventKind::kOther;
+        ev->stamp_us = m.utime;
+        ev->payload = motion::Pose2D{m.x, m.y, m.theta};
+        return true;
+      });
+
+  add(mbot_legacy::occupancy_grid_t::getHash(), "occupancy_grid_t", kLegacy,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        return DecodeGrid<mbot_legacy::occupancy_grid_t>(d, n, 36, ev, err);
+      });
+  add(mbot_legacy::occupancy_grid_t::getHash(), "occupancy_grid_t", kCurrent, nullptr);
+  add(mbot_w23::occupancy_grid_t::getHash(), "occupancy_grid_t", kW23,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        // num_cells is followed by slam_mode and a string before the cells: check against the rest.
+        return DecodeGrid<mbot_w23::occupancy_grid_t>(d, n, 36, ev, err);
+      });
+
+  add(mbot_legacy::particles_t::getHash(), "particles_t", kLegacy, Other<mbot_legacy::particles_t>(16, 48, "num_particles"));
+  add(mbot_legacy::particles_t::getHash(), "particles_t", kW23, nullptr);
+  add(mbot_legacy::particles_t::getHash(), "particles_t", kCurrent, nullptr);
+  add(mbot_legacy::robot_path_t::getHash(), "robot_path_t", kLegacy, Other<mbot_legacy::robot_path_t>(16, 20, "path_length"));
+  add(mbot_legacy::robot_path_t::getHash(), "path2D_t", kCurrent, nullptr);
+  add(mbot_legacy::timestamp_t::getHash(), "timestamp_t", kLegacy, Other<mbot_legacy::timestamp_t>());
+  add(mbot_legacy::timestamp_t::getHash(), "timestamp_t", kW23, nullptr);
+  add(mbot_legacy::timestamp_t::getHash(), "timestamp_t", kCurrent, nullptr);
+  add(mbot_legacy::message_received_t::getHash(), "message_received_t", kLegacy, Other<mbot_legacy::message_received_t>());
+  add(mbot_legacy::message_received_t::getHash(), "mbot_message_received_t", kCurrent, nullptr);
+  add(mbot_legacy::exploration_status_t::getHash(), "exploration_status_t", kLegacy, Other<mbot_legacy::exploration_status_t>());
+  add(mbot_legacy::exploration_status_t::getHash(), "exploration_status_t", kW23, nullptr);
+  add(mbot_lcm_msgs::exploration_status_t::getHash(), "exploration_status_t", kCurrent, Other<mbot_lcm_msgs::exploration_status_t>());
+  add(mbot_lcm_msgs::slam_status_t::getHash(), "slam_status_t", kCurrent, Other<mbot_lcm_msgs::slam_status_t>());
+  add(mbot_lcm_msgs::mbot_slam_reset_t::getHash(), "mbot_slam_reset_t", kCurrent, Other<mbot_lcm_msgs::mbot_slam_reset_t>());
+  add(mbot_w23::mbot_system_reset_t::getHash(), "mbot_system_reset_t", kW23, nullptr);
+  return t;
+}
+
+const std::map<int64_t, Entry>& Table() {
+  static const std::map<int64_t, Entry> table = BuildTable();
+  return table;
+}
+
+}  // namespace
+
+int64_t Fingerprint(const uint8_t* data, size_t size) {
+  if (size < 8) return 0;
+  uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v = (v << 8) | data[i];
+  return static_cast<int64_t>(v);
+}
+
+const TypeInfo* LookUp(int64_t fingerprint) {
+  auto it = Table().find(fingerprint);
+  return it == Table().end() ? nullptr : &it->second.info;
+}
+
+bool Decode(const std::string& channel, const uint8_t* data, size_t size, const ChannelRoles& roles, Event* event,
+            std::string* error) {
+  auto it = Table().find(Fingerprint(data, size));
+  if (it == Table().end()) {
+    *error = "unknown fingerprint";
+    return false;
+  }
+  return it->second.decode(channel, data, size, roles, event, error);
+}
+
+std::vector<std::pair<int64_t, TypeInfo>> KnownTypes() {
+  std::vector<std::pair<int64_t, TypeInfo>> out;
+  for (const auto& [hash, e] : Table()) out.emplace_back(hash, e.info);
+  return out;
+}
+
+}  // namespace mbot::drivers::lcm_adapter

@@ -1,0 +1,34 @@
+// LCM message → Event adapter (the one place that knows the botlab wire types). Each known
+// fingerprint maps to a decoder; fingerprints are shared by generations whose layouts agree.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "mbot/drivers/events.hpp"
+#include "mbot/drivers/source_options.hpp"
+
+namespace mbot::drivers::lcm_adapter {
+
+struct TypeInfo {
+  std::string type;        // e.g. "lidar_t" or "pose_xyt_t/odometry_t/pose2D_t"
+  std::string generation;  // e.g. "legacy 2017-2022, W23, 2023+"
+};
+
+// Reads the 8-byte fingerprint at the start of an LCM payload (0 when shorter than 8 bytes).
+int64_t Fingerprint(const uint8_t* data, size_t size);
+
+// The type registered for a fingerprint, or nullptr when unknown.
+const TypeInfo* LookUp(int64_t fingerprint);
+
+// Decodes one message into `event` (kind, stamp_us, payload; t_us and channel are set by the
+// caller). Returns false with `error` set when the message is malformed: a count that disagrees
+// with the payload length, trailing bytes, non-finite poses. Never reads out of bounds.
+bool Decode(const std::string& channel, const uint8_t* data, size_t size, const ChannelRoles& roles,
+            Event* event, std::string* error);
+
+// All registered fingerprints (for tests and --list-types).
+std::vector<std::pair<int64_t, TypeInfo>> KnownTypes();
+
+}  // namespace mbot::drivers::lcm_adapter

@@ -1,0 +1,275 @@
+#include "mbot/drivers/map_io.hpp"
+
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/maps/COccupancyGridMap2D.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "mbot/common/atomic_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace mbot::drivers {
+namespace {
+
+std::string ShortestDouble(double v) {
+  char buf[32];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+[[noreturn]] void Fail(const std::string& path, const std::string& why) { throw std::runtime_error(path + ": " + why); }
+
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+std::string Trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t\r\n");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t\r\n") - b + 1);
+}
+
+}  // namespace
+
+mapping::OccupancyGrid ReadBotlabMap(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) Fail(path, "cannot open map");
+  double ox, oy, res;
+  long long w, h;
+  if (!(in >> ox >> oy >> w >> h >> res)) Fail(path, "line 1: expected 'origin_x origin_y width height meters_per_cell'");
+  if (w <= 0 || h <= 0 || w * h > (1LL << 31) || !(res > 0) || !std::isfinite(ox) || !std::isfinite(oy)) {
+    Fail(path, "line 1: implausible header (" + std::to_string(w) + "x" + std::to_string(h) + ", resolution " +
+                   ShortestDouble(res) + ")");
+  }
+  mapping::OccupancyGrid grid(static_cast<int>(w), static_cast<int>(h), res, ox, oy);
+  for (long long y = 0; y < h; ++y) {
+    for (long long x = 0; x < w; ++x) {
+      int v;
+      if (!(in >> v)) {
+        Fail(path, "line " + std::to_string(y + 2) + ": expected " + std::to_string(w) + " cells, file ends or has a non-number at cell " +
+                       std::to_string(x));
+      }
+      if (v < -128 || v > 127) Fail(path, "line " + std::to_string(y + 2) + ": cell value " + std::to_string(v) + " outside int8");
+      grid.at(static_cast<int>(x), static_cast<int>(y)) = static_cast<int8_t>(std::max(v, -127));
+    }
+  }
+  std::string extra;
+  if (in >> extra) Fail(path, "more cells than width x height (" + std::to_string(w * h) + ")");
+  return grid;
+}
+
+void WriteBotlabMap(const mapping::OccupancyGrid& g, const std::string& path) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << ShortestDouble(g.origin_x()) << ' ' << ShortestDouble(g.origin_y()) << ' ' << g.width() << ' '
+        << g.height() << ' ' << ShortestDouble(g.resolution()) << '\n';
+    std::string row;
+    for (int y = 0; y < g.height(); ++y) {
+      row.clear();
+      for (int x = 0; x < g.width(); ++x) {
+        row += std::to_string(int(g.at(x, y)));
+        row += ' ';
+      }
+      row.back() = '\n';
+      out << row;
+    }
+  });
+}
+
+mapping::OccupancyGrid ReadRosMap(const std::string& yaml_path) {
+  std::ifstream in(yaml_path);
+  if (!in) Fail(yaml_path, "cannot open map YAML");
+  std::string image;
+  double res = 0, ox = 0, oy = 0, yaw = 0, occ_th = 0.65, free_th = 0.196;
+  bool negate = false, have_res = false, have_origin = false;
+  std::string mode = "trinary";
+  std::string line;
+  int line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line = line.substr(0, hash);
+    const auto colon = line.find(':');
+    if (Trim(line).empty()) continue;
+    if (colon == std::string::npos) Fail(yaml_path, "line " + std::to_string(line_no) + ": expected 'key: value'");
+    const std::string key = Trim(line.substr(0, colon));
+    std::string value = Trim(line.substr(colon + 1));
+    const std::string where = "line " + std::to_string(line_no) + ": " + key + ": ";
+    try {
+      if (key == "image") {
+        if (value.size() >= 2 && (value[0] == '"' || value[0] == '\'')) value = value.substr(1, value.size() - 2);
+        image = value;
+      } else if (key == "resolution") {
+        res = std::stod(value);
+        have_res = true;
+      } else if (key == "origin") {
+        std::string v = value;
+        std::replace(v.begin(), v.end(), '[', ' ');
+        std::replace(v.begin(), v.end(), ']', ' ');
+        std::replace(v.begin(), v.end(), ',', ' ');
+        std::istringstream s(v);
+        if (!(s >> ox >> oy >> yaw)) Fail(yaml_path, where + "expected [x, y, yaw]");
+        have_origin = true;
+      } else if (key == "negate") {
+        negate = std::stoi(value) != 0;
+      } else if (key == "occupied_thresh") {
+        occ_th = std::stod(value);
+      } else if (key == "free_thresh") {
+        free_th = std::stod(value);
+      } else if (key == "mode") {
+        mode = value;
+      }
+    } catch (const std::logic_error&) {
+      Fail(yaml_path, where + "bad value '" + value + "'");
+    }
+  }
+  if (image.empty()) Fail(yaml_path, "missing key 'image'");
+  if (!have_res || !(res > 0)) Fail(yaml_path, "missing or bad 'resolution'");
+  if (!have_origin) Fail(yaml_path, "missing 'origin'");
+  if (std::abs(yaw) > 1e-9) Fail(yaml_path, "origin yaw " + ShortestDouble(yaw) + " is not supported (only axis-aligned maps)");
+  if (mode != "trinary" && mode != "scale") Fail(yaml_path, "mode '" + mode + "' is not supported (trinary, scale)");
+  const fs::path img_path = fs::path(image).is_absolute() ? fs::path(image) : fs::path(yaml_path).parent_path() / image;
+  cv::Mat img = cv::imread(img_path.string(), cv::IMREAD_GRAYSCALE);
+  if (img.empty()) Fail(img_path.string(), "cannot read map image (named in " + yaml_path + ")");
+  mapping::OccupancyGrid grid(img.cols, img.rows, res, ox, oy);
+  for (int r = 0; r < img.rows; ++r) {
+    const uint8_t* row = img.ptr<uint8_t>(r);
+    const int y = img.rows - 1 - r;
+    for (int x = 0; x < img.cols; ++x) {
+      const int p = negate ? 255 - row[x] : row[x];
+      const double occ = (255.0 - p) / 255.0;
+      int8_t v = 0;
+      if (occ > occ_th) v = static_cast<int8_t>(std::clamp(127 - p, 1, 127));
+      else if (occ < free_th) v = static_cast<int8_t>(std::clamp(127 - p, -127, -1));
+      grid.at(x, y) = v;
+    }
+  }
+  return grid;
+}
+
+void WriteRosMap(const mapping::OccupancyGrid& g, const std::string& yaml_path) {
+  const fs::path yaml(yaml_path);
+  const fs::path pgm = fs::path(yaml).replace_extension(".pgm");
+  cv::Mat img(g.height(), g.width(), CV_8UC1);
+  for (int y = 0; y < g.height(); ++y) {
+    uint8_t* row = img.ptr<uint8_t>(g.height() - 1 - y);
+    for (int x = 0; x < g.width(); ++x) row[x] = static_cast<uint8_t>(127 - int(g.at(x, y)));
+  }
+  const std::string tmp = TempPathFor(pgm.string());
+  if (!cv::imwrite(tmp, img)) Fail(pgm.string(), "cannot write image");
+  CommitFile(tmp, pgm.string());
+  WriteFileAtomically(yaml_path, [&](std::ostream& out) {
+    out << "image: " << pgm.filename().string() << "\n"
+        << "resolution: " << ShortestDouble(g.resolution()) << "\n"
+        << "origin: [" << ShortestDouble(g.origin_x()) << ", " << ShortestDouble(g.origin_y()) << ", 0.0]\n"
+        << "negate: 0\n"
+        << "# pixel = 127 - log-odds: these thresholds split occupied / free at log-odds 0\n"
+        << "occupied_thresh: 0.501\n"
+        << "free_thresh: 0.499\n"
+        << "mode: trinary\n";
+  });
+}
+
+mapping::OccupancyGrid ReadMrptGridmap(const std::string& path) {
+  mrpt::maps::COccupancyGridMap2D m;
+  try {
+    mrpt::io::CFileGZInputStream f(path);
+    auto arch = mrpt::serialization::archiveFrom(f);
+    auto obj = arch.ReadObject();
+    auto grid = std::dynamic_pointer_cast<mrpt::maps::COccupancyGridMap2D>(obj);
+    if (!grid) Fail(path, std::string("holds a ") + obj->GetRuntimeClass()->className + ", not a COccupancyGridMap2D");
+    m = *grid;
+  } catch (const std::runtime_error& e) {
+    if (std::string(e.what()).rfind(path, 0) == 0) throw;
+    Fail(path, std::string("cannot read MRPT gridmap: ") + e.what());
+  }
+  mapping::OccupancyGrid out(static_cast<int>(m.getSizeX()), static_cast<int>(m.getSizeY()), m.getResolution(),
+                             m.getXMin(), m.getYMin());
+  for (int y = 0; y < out.height(); ++y) {
+    for (int x = 0; x < out.width(); ++x) {
+      const double p_occ = std::clamp(1.0 - double(m.getCell(x, y)), 1e-6, 1.0 - 1e-6);
+      out.at(x, y) = static_cast<int8_t>(std::clamp(std::lround(20.0 * std::log(p_occ / (1.0 - p_occ))), -127L, 127L));
+    }
+  }
+  return out;
+}
+
+mapping::OccupancyGrid ReadMovingAiMap(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) Fail(path, "cannot open map");
+  std::string line, word;
+  int w = -1, h = -1, line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    std::istringstream s(Trim(line));
+    s >> word;
+    if (word == "type") continue;
+    if (word == "height") s >> h;
+    else if (word == "width") s >> w;
+    else if (word == "map") break;
+    else Fail(path, "line " + std::to_string(line_no) + ": unexpected header '" + Trim(line) + "'");
+  }
+  if (w <= 0 || h <= 0) Fail(path, "missing width/height header");
+  mapping::OccupancyGrid grid(w, h, 1.0, 0.0, 0.0);
+  for (int r = 0; r < h; ++r) {
+    if (!std::getline(in, line)) Fail(path, "ends after " + std::to_string(r) + " of " + std::to_string(h) + " rows");
+    ++line_no;
+    line = Trim(line);  // CRLF files
+    if (static_cast<int>(line.size()) != w) {
+      Fail(path, "line " + std::to_string(line_no) + ": row has " + std::to_string(line.size()) + " cells, expected " +
+                     std::to_string(w));
+    }
+    for (int x = 0; x < w; ++x) {
+      const char c = line[x];
+      grid.at(x, h - 1 - r) = (c == '.' || c == 'G' || c == 'S') ? int8_t(-127) : int8_t(127);
+    }
+  }
+  return grid;
+}
+
+void WriteMapPng(const mapping::OccupancyGrid& g, const std::string& path) {
+  cv::Mat img(g.height(), g.width(), CV_8UC1);
+  for (int y = 0; y < g.height(); ++y) {
+    uint8_t* row = img.ptr<uint8_t>(g.height() - 1 - y);
+    for (int x = 0; x < g.width(); ++x) row[x] = static_cast<uint8_t>(127 - int(g.at(x, y)));
+  }
+  const std::string tmp = TempPathFor(path);
+  if (!cv::imwrite(tmp, img)) Fail(path, "cannot write PNG");
+  CommitFile(tmp, path);
+}
+
+mapping::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format) {
+  auto set = [&](const char* f) {
+    if (format) *format = f;
+  };
+  if (EndsWith(path, ".yaml") || EndsWith(path, ".yml")) {
+    set("ROS map_server (PGM + YAML)");
+    return ReadRosMap(path);
+  }
+  if (EndsWith(path, ".gridmap") || EndsWith(path, ".gridmap.gz")) {
+    set("MRPT gridmap");
+    return ReadMrptGridmap(path);
+  }
+  if (EndsWith(path, ".map")) {
+    std::ifstream in(path);
+    std::string first;
+    in >> first;
+    if (first == "type") {
+      set("Moving AI map");
+      return ReadMovingAiMap(path);
+    }
+    set("botlab .map");
+    return ReadBotlabMap(path);
+  }
+  Fail(path, "not a known map format (.map, .yaml, .gridmap, .gridmap.gz)");
+}
+
+}  // namespace mbot::drivers

@@ -1,0 +1,173 @@
+#include "rawlog_source.hpp"
+
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/obs/CRawlog.h>
+#include <mrpt/obs/CSensoryFrame.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+
+#include "mbot/common/log.hpp"
+
+namespace mbot::drivers {
+namespace {
+
+int64_t ToMicros(mrpt::Clock::time_point t) {
+  if (t == mrpt::Clock::time_point()) return INT64_MIN;
+  return static_cast<int64_t>(std::llround(mrpt::Clock::toDouble(t) * 1e6));
+}
+
+std::string ClassName(const mrpt::rtti::CObject& o) {
+  const std::string name = o.GetRuntimeClass()->className;
+  const auto colon = name.rfind("::");
+  return colon == std::string::npos ? name : name.substr(colon + 2);
+}
+
+std::string Label(const mrpt::obs::CObservation& obs) {
+  return obs.sensorLabel.empty() ? ClassName(obs) : obs.sensorLabel;
+}
+
+}  // namespace
+
+RawlogSource::RawlogSource(const SourceOptions& options) {
+  if (!std::filesystem::is_regular_file(options.path)) throw std::runtime_error(options.path + ": no such file");
+  mrpt::obs::CRawlog rawlog;
+  bool ok = false;
+  try {
+    ok = rawlog.loadFromRawLogFile(options.path);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(options.path + ": cannot read MRPT rawlog: " + e.what());
+  }
+  if (!ok) throw std::runtime_error(options.path + ": cannot read MRPT rawlog");
+  if (rawlog.size() == 0) mbot::log::Warn(options.path + ": the rawlog holds no entries");
+
+  motion::Pose2D odom;  // integrated from the actions of the Actions/SensoryFrame format
+  // Entries without a timestamp are marked INT64_MIN and filled in below.
+  auto stamp = [&](int64_t t) {
+    if (t == INT64_MIN) ++invalid_stamps_;
+    return t;
+  };
+  auto add_observation = [&](const mrpt::obs::CObservation::Ptr& obs) {
+    Event ev;
+    ev.t_us = stamp(ToMicros(obs->timestamp));
+    ev.stamp_us = ev.t_us;
+    ev.channel = Label(*obs);
+    auto& info = channels_[ev.channel];
+    info.type = ClassName(*obs);
+    if (auto scan = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(obs)) {
+      LidarScan s;
+      const size_t n = scan->getScanSize();
+      s.ranges_m.resize(n);
+      s.angles_rad.resize(n);
+      for (size_t i = 0; i < n; ++i) {
+        s.ranges_m[i] = scan->getScanRangeValidity(i) ? scan->getScanRange(i) : 0.0f;
+        s.angles_rad[i] = scan->getScanAngle(i);
+      }
+      s.max_range_m = scan->maxRange;
+      s.sensor_pose = {scan->sensorPose.x(), scan->sensorPose.y(), scan->sensorPose.yaw()};
+      ev.kind = EventKind::kLidar;
+      ev.payload = std::move(s);
+    } else if (auto od = std::dynamic_pointer_cast<mrpt::obs::CObservationOdometry>(obs)) {
+      ev.kind = EventKind::kOdometry;
+      ev.payload = motion::Pose2D{od->odometry.x(), od->odometry.y(), od->odometry.phi()};
+      if (od->hasEncodersInfo) {
+        Event enc = ev;
+        enc.kind = EventKind::kEncoders;
+        enc.channel = ev.channel + ".encoders";
+        enc.payload = EncoderTicks{0, 0, od->encoderLeftTicks, od->encoderRightTicks, 0};
+        channels_[enc.channel] = ChannelInfo{"CObservationOdometry (encoders)", "", EventKind::kEncoders, true};
+        events_.push_back(std::move(enc));
+      }
+    } else {
+      ev.kind = EventKind::kOther;
+    }
+    info.kind = ev.kind;
+    events_.push_back(std::move(ev));
+  };
+
+  for (size_t i = 0; i < rawlog.size(); ++i) {
+    switch (rawlog.getType(i)) {
+      case mrpt::obs::CRawlog::etActionCollection: {
+        ++actions_;
+        auto acts = rawlog.getAsAction(i);
+        for (size_t k = 0; k < acts->size(); ++k) {
+          auto act = acts->get(k);
+          auto mov = std::dynamic_pointer_cast<mrpt::obs::CActionRobotMovement2D>(act);
+          if (!mov) continue;
+          const auto inc = mov->rawOdometryIncrementReading;
+          odom = odom.Compose({inc.x(), inc.y(), inc.phi()});
+          Event ev;
+          ev.t_us = stamp(ToMicros(mov->timestamp));
+          ev.stamp_us = ev.t_us;
+          ev.channel = "ACTION_ODOMETRY";
+          ev.kind = EventKind::kOdometry;
+          ev.payload = odom;
+          channels_[ev.channel] = ChannelInfo{"CActionRobotMovement2D (integrated)", "", EventKind::kOdometry, true};
+          events_.push_back(std::move(ev));
+        }
+        break;
+      }
+      case mrpt::obs::CRawlog::etSensoryFrame: {
+        ++sensory_frames_;
+        auto sf = rawlog.getAsObservations(i);
+        for (const auto& obs : *sf) add_observation(obs);
+        break;
+      }
+      case mrpt::obs::CRawlog::etObservation:
+        ++observations_;
+        add_observation(rawlog.getAsObservation(i));
+        break;
+      default:
+        break;
+    }
+  }
+  // An entry without timestamp takes the time of the entry before it (or after it, at the start).
+  int64_t last_t = INT64_MIN;
+  for (auto& ev : events_) {
+    if (ev.t_us == INT64_MIN) ev.t_us = ev.stamp_us = last_t;
+    else last_t = ev.t_us;
+  }
+  last_t = INT64_MIN;
+  for (auto it = events_.rbegin(); it != events_.rend(); ++it) {
+    if (it->t_us == INT64_MIN) it->t_us = it->stamp_us = last_t;
+    else last_t = it->t_us;
+  }
+  if (last_t == INT64_MIN) {
+    for (auto& ev : events_) ev.t_us = ev.stamp_us = 0;
+  }
+  if (invalid_stamps_) {
+    mbot::log::Warn(options.path + ": " + std::to_string(invalid_stamps_) +
+                    " entries have no timestamp; they take the time of the entry before them");
+  }
+  std::stable_sort(events_.begin(), events_.end(), [](const Event& a, const Event& b) { return a.t_us < b.t_us; });
+}
+
+std::optional<Event> RawlogSource::Next() {
+  if (next_ >= events_.size()) return std::nullopt;
+  return std::move(events_[next_++]);
+}
+
+double RawlogSource::Progress() const {
+  return events_.empty() ? 1.0 : double(next_) / double(events_.size());
+}
+
+std::string RawlogSource::Format() const {
+  return sensory_frames_ > 0 || actions_ > 0 ? "MRPT rawlog (actions / sensory frames)"
+                                             : "MRPT rawlog (observations only)";
+}
+
+std::vector<std::pair<std::string, std::string>> RawlogSource::Details() const {
+  std::vector<std::pair<std::string, std::string>> d;
+  d.emplace_back("actions", std::to_string(actions_));
+  d.emplace_back("sensory frames", std::to_string(sensory_frames_));
+  d.emplace_back("stand-alone observations", std::to_string(observations_));
+  if (invalid_stamps_) d.emplace_back("entries without timestamp", std::to_string(invalid_stamps_));
+  return d;
+}
+
+}  // namespace mbot::drivers

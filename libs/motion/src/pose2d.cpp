@@ -1,0 +1,50 @@
+#include "mbot/motion/pose2d.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace mbot::motion {
+
+double WrapAngle(double a) {
+  a = std::fmod(a + M_PI, 2.0 * M_PI);
+  if (a <= 0.0) a += 2.0 * M_PI;
+  return a - M_PI;
+}
+
+Pose2D Pose2D::Compose(const Pose2D& o) const {
+  const double c = std::cos(theta), s = std::sin(theta);
+  return {x + c * o.x - s * o.y, y + s * o.x + c * o.y, WrapAngle(theta + o.theta)};
+}
+
+Pose2D Pose2D::Inverse() const {
+  const double c = std::cos(theta), s = std::sin(theta);
+  return {-c * x - s * y, s * x - c * y, WrapAngle(-theta)};
+}
+
+Pose2D Interpolate(const Pose2D& a, const Pose2D& b, double s) {
+  return {a.x + s * (b.x - a.x), a.y + s * (b.y - a.y),
+          WrapAngle(a.theta + s * WrapAngle(b.theta - a.theta))};
+}
+
+bool InterpolateAt(const std::vector<TimedPose>& series, int64_t t_us, int64_t max_gap_us, Pose2D* out) {
+  if (series.empty()) return false;
+  auto it = std::lower_bound(series.begin(), series.end(), t_us,
+                             [](const TimedPose& p, int64_t t) { return p.t_us < t; });
+  if (it == series.end()) {
+    if (t_us - series.back().t_us > max_gap_us) return false;
+    *out = series.back().pose;
+    return true;
+  }
+  if (it == series.begin() || it->t_us == t_us) {
+    if (it->t_us - t_us > max_gap_us) return false;
+    *out = it->pose;
+    return true;
+  }
+  const TimedPose& b = *it;
+  const TimedPose& a = *(it - 1);
+  if (b.t_us - a.t_us > max_gap_us) return false;
+  *out = Interpolate(a.pose, b.pose, double(t_us - a.t_us) / double(b.t_us - a.t_us));
+  return true;
+}
+
+}  // namespace mbot::motion
