@@ -172,8 +172,8 @@ void WriteRosMap(const mapping::OccupancyGrid& g, const std::string& yaml_path) 
         << "origin: [" << ShortestDouble(g.origin_x()) << ", " << ShortestDouble(g.origin_y()) << ", 0.0]\n"
         << "negate: 0\n"
         << "# pixel = 127 - log-odds: these thresholds split occupied / free at log-odds 0\n"
-        << "occupied_thresh: 0.501\n"
-        << "free_thresh: 0.499\n"
+        << "occupied_thresh: 0.504\n"  // log-odds >= 1 (pixel <= 126) is occupied
+        << "free_thresh: 0.5\n"        // log-odds <= -1 (pixel >= 128) is free
         << "mode: trinary\n";
   });
 }

@@ -1,0 +1,60 @@
+#include "pipeline.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+namespace mbot::app {
+namespace {
+
+std::string ErrorOf(const std::string& ini) {
+  try {
+    BuildPlan(config::Config::FromString(ini, "t.ini"));
+  } catch (const config::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+constexpr const char* kBase = "[pipeline]\nstages = s\n[source]\npath = x.log\n";
+
+TEST(PipelineTest, BuildsRegisteredStages) {
+  auto plan = BuildPlan(config::Config::FromString(std::string(kBase) + "[s]\ntype = inspect\n", "t.ini"));
+  ASSERT_EQ(plan.stages.size(), 1u);
+  EXPECT_EQ(plan.stages[0].first, "s");
+  EXPECT_EQ(plan.source.path, "x.log");
+}
+
+TEST(PipelineTest, UnknownStageTypeListsTheKnownOnes) {
+  const auto e = ErrorOf(std::string(kBase) + "[s]\ntype = nope\n");
+  EXPECT_NE(e.find("t.ini:6: [s] type: unknown stage type 'nope' (known: inspect, map_writer, trajectory_writer)"),
+            std::string::npos)
+      << e;
+}
+
+TEST(PipelineTest, StrictErrors) {
+  EXPECT_NE(ErrorOf(std::string(kBase) + "[s]\ntype = inspect\nbogus = 1\n").find("[s] bogus: unknown key"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(std::string(kBase)).find("stage 's' has no [s] section"), std::string::npos);
+  EXPECT_NE(ErrorOf(std::string(kBase) + "[s]\ntype = inspect\n[extra]\nx = 1\n").find("[extra] is not used"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("[pipeline]\nstages = s\n[s]\ntype = inspect\n").find("[source] path: required key is missing"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(std::string(kBase) + "type = lcm\n[s]\ntype = inspect\n").find("[source] type: 'lcm' is not one of"),
+            std::string::npos);
+}
+
+// Every shipped configuration parses strictly (keys, sections, stage types, values).
+TEST(PipelineTest, EveryShippedConfigIsValid) {
+  int n = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(MBOT_SOURCE_DIR) + "/config")) {
+    if (entry.path().extension() != ".ini" || entry.path().filename() == "defaults.ini") continue;
+    SCOPED_TRACE(entry.path().string());
+    EXPECT_NO_THROW(BuildPlan(config::Config::Load(entry.path().string())));
+    ++n;
+  }
+  EXPECT_GE(n, 3);
+}
+
+}  // namespace
+}  // namespace mbot::app

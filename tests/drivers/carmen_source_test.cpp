@@ -1,0 +1,68 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "carmen_source.hpp"
+#include "mbot/drivers/source_options.hpp"
+#include "test_util.hpp"
+
+namespace mbot::drivers {
+namespace {
+
+TEST(CarmenSourceTest, BeamGeometryFollowsCarmen) {
+  double start, inc;
+  CarmenSource::GuessBeamGeometry(180, &start, &inc);
+  EXPECT_NEAR(inc * 180 / M_PI, 1.0, 1e-12);
+  EXPECT_NEAR(start * 180 / M_PI, -89.5, 1e-9);
+  CarmenSource::GuessBeamGeometry(361, &start, &inc);
+  EXPECT_NEAR(inc * 180 / M_PI, 0.5, 1e-12);
+  EXPECT_NEAR(start * 180 / M_PI, -90.0, 1e-9);
+}
+
+TEST(CarmenSourceTest, ParsesOldAndNewLinesKeepingPoseAndOdometryApart) {
+  const auto path = test::TempPath("t.log");
+  std::ofstream(path) << "# comment\n"
+                         "PARAM robot_front_laser_max 50 nohost 0\n"
+                         "ODOM 1 2 0.5 0 0 0 10.25 host 10.25\n"
+                         "FLASER 3 1.0 2.0 60.0 0.1 0.2 0.3 0.4 0.5 0.6 11.5 host 11.5\n"
+                         "ROBOTLASER1 0 -1.5708 3.1416 1.5708 30 0.01 0 3 1 2 3 0 0.2 0 0 0 0 0 0 0 0 0 0 12.0 h 12.0\n"
+                         "FLASER 2 1.0 bogus 0 0 0 0 0 0 13 host 13\n"
+                         "NEFF 1 2\n";
+  SourceOptions o;
+  o.path = path;
+  auto src = OpenSource(o);
+  std::vector<Event> ev;
+  while (auto e = src->Next()) ev.push_back(std::move(*e));
+  ASSERT_EQ(ev.size(), 6u);
+  EXPECT_EQ(ev[0].channel, "ODOM");
+  EXPECT_EQ(ev[0].t_us, 10250000);
+  EXPECT_EQ(ev[1].kind, EventKind::kLidar);
+  const auto& scan = std::get<LidarScan>(ev[1].payload);
+  EXPECT_EQ(scan.ranges_m.size(), 3u);
+  EXPECT_FLOAT_EQ(scan.max_range_m, 50.0f);  // from PARAM robot_front_laser_max
+  EXPECT_EQ(ev[2].kind, EventKind::kReferencePose);
+  EXPECT_NEAR(std::get<motion::Pose2D>(ev[2].payload).x, 0.1, 1e-12);
+  EXPECT_EQ(ev[3].kind, EventKind::kOdometry);
+  EXPECT_NEAR(std::get<motion::Pose2D>(ev[3].payload).x, 0.4, 1e-12);
+  EXPECT_EQ(ev[5].channel, "ROBOTLASER1");
+  const auto& rl = std::get<LidarScan>(ev[5].payload);
+  EXPECT_NEAR(rl.angles_rad[2] - rl.angles_rad[1], 1.5708, 1e-5);
+  EXPECT_NEAR(rl.sensor_pose.x, 0.2, 1e-9);
+  EXPECT_EQ(src->diagnostics().rejected_messages, 1);  // the 'bogus' line
+}
+
+TEST(CarmenSourceTest, ReadsGzip) {
+  const auto path = test::TempPath("t2.log");
+  std::ofstream(path) << "ODOM 1 2 0.5 0 0 0 10.25 host 10.25\n";
+  ASSERT_EQ(std::system(("gzip -f " + path).c_str()), 0);
+  SourceOptions o;
+  o.path = path + ".gz";
+  EXPECT_EQ(DetectFormat(o.path), "carmen");
+  auto src = OpenSource(o);
+  EXPECT_TRUE(src->Next());
+  EXPECT_FALSE(src->Next());
+}
+
+}  // namespace
+}  // namespace mbot::drivers

@@ -1,0 +1,92 @@
+#include "mbot/drivers/map_io.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "test_util.hpp"
+
+namespace mbot::drivers {
+namespace {
+
+mapping::OccupancyGrid Fixture() {
+  mapping::OccupancyGrid g(7, 5, 0.05, -1.25, 2.5);
+  int v = -127;
+  for (auto& c : g.cells()) {
+    c = static_cast<int8_t>(v);
+    v = v >= 120 ? -127 : v + 9;
+  }
+  g.at(0, 0) = 127;
+  g.at(6, 4) = 0;
+  return g;
+}
+
+TEST(MapIoTest, BotlabMapRoundTripIsLossless) {
+  const auto g = Fixture();
+  const auto path = test::TempPath("g.map");
+  WriteBotlabMap(g, path);
+  EXPECT_EQ(ReadBotlabMap(path), g);
+}
+
+TEST(MapIoTest, RosMapRoundTripIsLossless) {
+  const auto g = Fixture();
+  const auto path = test::TempPath("g.yaml");
+  WriteRosMap(g, path);
+  const auto back = ReadRosMap(path);
+  EXPECT_EQ(back, g);
+}
+
+TEST(MapIoTest, RosMapFollowsMapServerThresholdsAndNegate) {
+  // 2x1 image: a black (occupied) and a 205 (unknown with default thresholds) pixel.
+  const auto pgm = test::TempPath("ros.pgm");
+  {
+    std::ofstream out(pgm, std::ios::binary);
+    out << "P5\n2 1\n255\n" << char(0) << char(205);
+  }
+  const auto yaml = test::TempPath("ros.yaml");
+  std::ofstream(yaml) << "image: ros.pgm\nresolution: 0.1\norigin: [1.0, 2.0, 0.0]\nnegate: 0\n"
+                         "occupied_thresh: 0.65\nfree_thresh: 0.196\n";
+  auto g = ReadRosMap(yaml);
+  EXPECT_GT(g.at(0, 0), 0);
+  EXPECT_EQ(g.at(1, 0), 0);
+  EXPECT_DOUBLE_EQ(g.origin_x(), 1.0);
+  std::ofstream(yaml) << "image: ros.pgm\nresolution: 0.1\norigin: [1.0, 2.0, 0.0]\nnegate: 1\n";
+  g = ReadRosMap(yaml);
+  EXPECT_LT(g.at(0, 0), 0);  // negated: black is free
+}
+
+TEST(MapIoTest, BadBotlabMapsNameFileAndLine) {
+  const auto path = test::TempPath("bad.map");
+  std::ofstream(path) << "0 0 3 2 0.05\n1 2 3\n4 x 6\n";
+  try {
+    ReadBotlabMap(path);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ": line 3"), std::string::npos) << e.what();
+  }
+  std::ofstream(path) << "0 0 -3 2 0.05\n";
+  EXPECT_THROW(ReadBotlabMap(path), std::runtime_error);
+}
+
+TEST(MapIoTest, MovingAiMapFlipsRowsAndHandlesCrlf) {
+  const auto path = test::TempPath("m.map");
+  std::ofstream(path) << "type octile\r\nheight 2\r\nwidth 3\r\nmap\r\n.@T\r\nG.S\r\n";
+  const auto g = ReadMovingAiMap(path);
+  ASSERT_EQ(g.width(), 3);
+  EXPECT_LT(g.at(0, 1), 0);  // '.' top-left → row height-1
+  EXPECT_GT(g.at(1, 1), 0);  // '@'
+  EXPECT_GT(g.at(2, 1), 0);  // 'T'
+  EXPECT_LT(g.at(2, 0), 0);  // 'S' passable
+}
+
+TEST(MapIoTest, PngIsWritten) {
+  const auto path = test::TempPath("g.png");
+  WriteMapPng(Fixture(), path);
+  std::ifstream in(path, std::ios::binary);
+  char sig[4] = {};
+  in.read(sig, 4);
+  EXPECT_EQ(std::string(sig + 1, 3), "PNG");
+}
+
+}  // namespace
+}  // namespace mbot::drivers
