@@ -334,8 +334,12 @@ TEST(Maps, AstarMapsAndCases) {
       EXPECT_EQ(g.height(), it->second.second);
     }
     const auto cells = g.CountCells();
-    if (std::string(name) == "filled") EXPECT_EQ(cells.occupied, g.width() * g.height());
-    if (std::string(name) == "empty") EXPECT_EQ(cells.free, g.width() * g.height());
+    if (std::string(name) == "filled") {
+      EXPECT_EQ(cells.occupied, g.width() * g.height());
+    }
+    if (std::string(name) == "empty") {
+      EXPECT_EQ(cells.free, g.width() * g.height());
+    }
   }
 }
 
@@ -371,16 +375,21 @@ TEST(Maps, MrptGridmap) {
 
 // ---- the application end to end ---------------------------------------------------------------
 
-TEST(App, InspectPipelineOnARealLogWritesItsSummary) {
+// Runs the shipped replay configuration into a fresh folder `out`; `stop` set = Ctrl-C at once.
+app::RunSummary RunReplay(const std::string& out, bool stop_at_once) {
   auto c = config::Config::Load(std::string(MBOT_SOURCE_DIR) + "/config/replay.ini");
-  const std::string out = (fs::temp_directory_path() / "mbot_regression_replay").string();
   fs::remove_all(out);
   c.Set("output.dir=" + out);
   c.Set("pipeline.progress=off");
   c.Set("inspect.print=false");
   auto plan = app::BuildPlan(c);
-  std::atomic<bool> stop{false};
-  const auto summary = app::RunPlan(plan, stop);
+  std::atomic<bool> stop{stop_at_once};
+  return app::RunPlan(plan, stop);
+}
+
+TEST(App, InspectPipelineOnARealLogWritesItsSummary) {
+  const std::string out = (fs::temp_directory_path() / "mbot_regression_replay").string();
+  const auto summary = RunReplay(out, false);
   EXPECT_EQ(summary.events, 6702);  // every record (6703) but lcm-logger's self test
   for (const char* f : {"inspect.json", "odometry.tum", "ground_truth.tum", "staff_slam.tum", "staff_slam_map.map",
                         "staff_slam_map.yaml", "staff_slam_map.pgm", "staff_slam_map.png"}) {
@@ -396,15 +405,8 @@ TEST(App, InspectPipelineOnARealLogWritesItsSummary) {
 }
 
 TEST(App, InterruptedRunStillWritesOutputs) {
-  auto c = config::Config::Load(std::string(MBOT_SOURCE_DIR) + "/config/replay.ini");
   const std::string out = (fs::temp_directory_path() / "mbot_regression_interrupted").string();
-  fs::remove_all(out);
-  c.Set("output.dir=" + out);
-  c.Set("pipeline.progress=off");
-  c.Set("inspect.print=false");
-  auto plan = app::BuildPlan(c);
-  std::atomic<bool> stop{true};  // as if Ctrl-C came before the first event
-  const auto summary = app::RunPlan(plan, stop);
+  const auto summary = RunReplay(out, true);  // as if Ctrl-C came before the first event
   EXPECT_TRUE(summary.interrupted);
   std::ifstream in(out + "/inspect.json");
   std::stringstream ss;

@@ -99,7 +99,7 @@ bool Finite(double a, double b, double c) { return std::isfinite(a) && std::isfi
 template <typename Lidar>
 bool DecodeLidar(const uint8_t* d, size_t n, Event* ev, std::string* err) {
   if (!CheckCount(d, n, 16, 20, "num_ranges", err)) return false;
-  Lidar m;
+  Lidar m{};
   if (!DecodeExact(d, n, &m, err)) return false;
   LidarScan scan;
   scan.ranges_m = std::move(m.ranges);
@@ -120,7 +120,7 @@ bool DecodeLidar(const uint8_t* d, size_t n, Event* ev, std::string* err) {
 
 bool DecodePose(const std::string& channel, const uint8_t* d, size_t n, const ChannelRoles& roles, Event* ev,
                 std::string* err) {
-  mbot_legacy::pose_xyt_t m;
+  mbot_legacy::pose_xyt_t m{};
   if (!DecodeExact(d, n, &m, err)) return false;
   if (!Finite(m.x, m.y, m.theta)) {
     *err = "non-finite pose";
@@ -138,7 +138,7 @@ bool DecodePose(const std::string& channel, const uint8_t* d, size_t n, const Ch
 template <typename Grid>
 bool DecodeGrid(const uint8_t* d, size_t n, size_t count_offset, Event* ev, std::string* err) {
   if (!CheckCount(d, n, count_offset, 1, "num_cells", err)) return false;
-  Grid m;
+  Grid m{};
   if (!DecodeExact(d, n, &m, err)) return false;
   if (m.width < 0 || m.height < 0 || int64_t(m.width) * m.height != m.num_cells ||
       !(m.meters_per_cell > 0.0f) || !std::isfinite(m.origin_x) || !std::isfinite(m.origin_y)) {
@@ -160,7 +160,7 @@ template <typename T>
 Decoder Other(size_t count_offset = 0, size_t element_bytes = 0, const char* field = nullptr) {
   return [=](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
     if (field && !CheckCount(d, n, count_offset, element_bytes, field, err)) return false;
-    T m;
+    T m{};
     if (!DecodeExact(d, n, &m, err)) return false;
     ev->kind = EventKind::kOther;
     ev->stamp_us = n >= 16 ? Fingerprint(d + 8, 8) : 0;  // every such type starts with utime
@@ -194,7 +194,7 @@ std::map<int64_t, Entry> BuildTable() {
 
   add(mbot_legacy::mbot_encoder_t::getHash(), "mbot_encoder_t", kLegacy,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
-        mbot_legacy::mbot_encoder_t m;
+        mbot_legacy::mbot_encoder_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->kind = EventKind::kEncoders;
         ev->stamp_us = m.utime;
@@ -204,7 +204,7 @@ std::map<int64_t, Entry> BuildTable() {
   add(mbot_legacy::mbot_encoder_t::getHash(), "mbot_encoder_t", kW23, nullptr);
   add(mbot_lcm_msgs::mbot_encoders_t::getHash(), "mbot_encoders_t", kCurrent,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
-        mbot_lcm_msgs::mbot_encoders_t m;
+        mbot_lcm_msgs::mbot_encoders_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->kind = EventKind::kEncoders;
         ev->stamp_us = m.utime;
@@ -213,7 +213,7 @@ std::map<int64_t, Entry> BuildTable() {
       });
   add(maebot::maebot_encoders_t::getHash(), "maebot_encoders_t", kMaebot,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
-        maebot::maebot_encoders_t m;
+        maebot::maebot_encoders_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->kind = EventKind::kEncoders;
         ev->stamp_us = m.utime;
@@ -223,7 +223,7 @@ std::map<int64_t, Entry> BuildTable() {
 
   add(mbot_legacy::mbot_imu_t::getHash(), "mbot_imu_t", kLegacy,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
-        mbot_legacy::mbot_imu_t m;
+        mbot_legacy::mbot_imu_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
         Imu imu;
         for (int i = 0; i < 3; ++i) {
@@ -240,7 +240,7 @@ std::map<int64_t, Entry> BuildTable() {
   add(mbot_legacy::mbot_imu_t::getHash(), "mbot_imu_t", kW23, nullptr);
   add(mbot_lcm_msgs::mbot_imu_t::getHash(), "mbot_imu_t", kCurrent,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
-        mbot_lcm_msgs::mbot_imu_t m;
+        mbot_lcm_msgs::mbot_imu_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
         Imu imu;
         for (int i = 0; i < 3; ++i) {
@@ -256,7 +256,7 @@ std::map<int64_t, Entry> BuildTable() {
       });
   add(maebot::maebot_imu_t::getHash(), "maebot_imu_t", kMaebot,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
-        maebot::maebot_imu_t m;
+        maebot::maebot_imu_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
         Imu imu;
         for (int i = 0; i < 3; ++i) {
@@ -273,7 +273,7 @@ std::map<int64_t, Entry> BuildTable() {
 
   add(mbot_legacy::mbot_motor_command_t::getHash(), "mbot_motor_command_t", kLegacy,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
-        mbot_legacy::mbot_motor_command_t m;
+        mbot_legacy::mbot_motor_command_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->kind = EventKind::kMotorCommand;
         ev->stamp_us = m.utime;
@@ -283,7 +283,7 @@ std::map<int64_t, Entry> BuildTable() {
   add(mbot_legacy::mbot_motor_command_t::getHash(), "mbot_motor_command_t", kW23, nullptr);
   add(mbot_lcm_msgs::twist2D_t::getHash(), "twist2D_t", kCurrent,
       [](const std::string& ch, const uint8_t* d, size_t n, const ChannelRoles& roles, Event* ev, std::string* err) {
-        mbot_lcm_msgs::twist2D_t m;
+        mbot_lcm_msgs::twist2D_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->stamp_us = m.utime;
         ev->kind = In(roles.velocity_command, ch) ? EventKind::kMotorCommand : EventKind::kOther;
@@ -292,7 +292,7 @@ std::map<int64_t, Entry> BuildTable() {
       });
   add(mbot_lcm_msgs::mbot_motor_pwm_t::getHash(), "mbot_motor_pwm_t", kCurrent,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
-        mbot_lcm_msgs::mbot_motor_pwm_t m;
+        mbot_lcm_msgs::mbot_motor_pwm_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->kind = EventKind::kMotorCommand;
         ev->stamp_us = m.utime;
@@ -301,7 +301,7 @@ std::map<int64_t, Entry> BuildTable() {
       });
   add(mbot_lcm_msgs::mbot_motor_vel_t::getHash(), "mbot_motor_vel_t", kCurrent,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
-        mbot_lcm_msgs::mbot_motor_vel_t m;
+        mbot_lcm_msgs::mbot_motor_vel_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->kind = EventKind::kOther;  // measured wheel speeds, not a command
         ev->stamp_us = m.utime;
@@ -310,7 +310,7 @@ std::map<int64_t, Entry> BuildTable() {
       });
   add(maebot::maebot_motor_command_t::getHash(), "maebot_motor_command_t", kMaebot,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
-        maebot::maebot_motor_command_t m;
+        maebot::maebot_motor_command_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->kind = EventKind::kMotorCommand;
         ev->stamp_us = m.utime;
@@ -320,7 +320,7 @@ std::map<int64_t, Entry> BuildTable() {
       });
   add(mbot_w23::mbot_wheel_ctrl_t::getHash(), "mbot_wheel_ctrl_t", kW23,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
-        mbot_w23::mbot_wheel_ctrl_t m;
+        mbot_w23::mbot_wheel_ctrl_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->kind = EventKind::kMotorCommand;
         ev->stamp_us = m.utime;
@@ -329,7 +329,7 @@ std::map<int64_t, Entry> BuildTable() {
       });
   add(mbot_w23::mbot_state_t::getHash(), "mbot_state_t", kW23,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
-        mbot_w23::mbot_state_t m;
+        mbot_w23::mbot_state_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->kind = EventKind::kOther;
         ev->stamp_us = m.utime;
