@@ -39,7 +39,7 @@ bool LcmLogReader::Resync(int64_t from) {
   // Scan forward for the next sync word, in chunks.
   ++resyncs_;
   std::vector<uint8_t> buf(1 << 16);
-  int64_t pos = from;
+  int64_t pos = from + 1;  // `from` is the bad record's first byte; the next sync word lies after it
   while (pos + 4 <= size_) {
     in_.clear();
     in_.seekg(pos);
@@ -87,7 +87,7 @@ std::optional<LcmLogRecord> LcmLogReader::Next() {
         data_len > kMaxDataLength) {
       mbot::log::Warn(path_ + ": bad record header at byte " + std::to_string(pos_) +
                       (sync != kSyncWord ? " (no sync word)" : " (implausible lengths)"));
-      if (!Resync(pos_ + 1)) return std::nullopt;
+      if (!Resync(pos_)) return std::nullopt;
       continue;
     }
     const int64_t end = pos_ + kHeaderSize + chan_len + int64_t(data_len);
@@ -111,7 +111,7 @@ std::optional<LcmLogRecord> LcmLogReader::Next() {
     for (char c : rec.channel) printable &= (c >= 0x20 && c < 0x7f);
     if (!printable) {
       mbot::log::Warn(path_ + ": record at byte " + std::to_string(pos_) + " has an unprintable channel name");
-      if (!Resync(pos_ + 1)) return std::nullopt;
+      if (!Resync(pos_)) return std::nullopt;
       continue;
     }
     pos_ = end;

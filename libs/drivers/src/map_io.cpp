@@ -246,6 +246,13 @@ void WriteMapPng(const mapping::OccupancyGrid& g, const std::string& path) {
   CommitFile(tmp, path);
 }
 
+bool IsMapFile(const std::string& path) {
+  for (const char* ext : {".yaml", ".yml", ".gridmap", ".gridmap.gz", ".map"}) {
+    if (EndsWith(path, ext)) return true;
+  }
+  return false;
+}
+
 mapping::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format) {
   auto set = [&](const char* f) {
     if (format) *format = f;

@@ -17,10 +17,6 @@
 namespace mbot::drivers {
 namespace {
 
-bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 // A map file as a source: one kMap event at t = 0.
 class MapSource : public Source {
  public:
@@ -68,11 +64,11 @@ SourceOptions ParseSourceOptions(config::Section& s) {
 
 std::string DetectFormat(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw std::runtime_error(path + ": no such file");
-  if (EndsWith(path, ".yaml") || EndsWith(path, ".yml") || EndsWith(path, ".gridmap") ||
-      EndsWith(path, ".gridmap.gz") || EndsWith(path, ".map")) {
-    return "map";
-  }
-  if (EndsWith(path, ".rawlog") || EndsWith(path, ".rawlog.gz")) return "rawlog";
+  if (IsMapFile(path)) return "map";
+  const auto ends_with = [&path](const std::string& s) {
+    return path.size() >= s.size() && path.compare(path.size() - s.size(), s.size(), s) == 0;
+  };
+  if (ends_with(".rawlog") || ends_with(".rawlog.gz")) return "rawlog";
   unsigned char head[4] = {0, 0, 0, 0};
   {
     std::ifstream in(path, std::ios::binary);

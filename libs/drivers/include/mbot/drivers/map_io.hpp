@@ -33,6 +33,9 @@ mapping::OccupancyGrid ReadMovingAiMap(const std::string& path);
 // A picture for people: occupied dark, free light, unknown grey, graded by log-odds; top = +y.
 void WriteMapPng(const mapping::OccupancyGrid& grid, const std::string& path);
 
+// True when `path` has the extension of a map format ReadAnyMap reads.
+bool IsMapFile(const std::string& path);
+
 // Reads any of the formats above, chosen by extension and content.
 mapping::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format = nullptr);
 
