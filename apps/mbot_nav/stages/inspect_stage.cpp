@@ -9,6 +9,7 @@
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/config.hpp"
+#include "report.hpp"
 #include "stages.hpp"
 
 namespace mbot::app {
@@ -36,32 +37,6 @@ struct ChannelStats {
   // maps
   std::shared_ptr<const mapping::OccupancyGrid> map;
 };
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
-std::string JsonString(const std::string& s) {
-  std::string o = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') o += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) {
-      o += ' ';
-      continue;
-    }
-    o += c;
-  }
-  return o + "\"";
-}
-
-std::string Num(double v, int precision = 6) {
-  if (!std::isfinite(v)) return "null";
-  std::ostringstream s;
-  s << std::setprecision(precision) << v;
-  return s.str();
-}
 
 struct InspectOptions {
   std::string json_file = "inspect.json";

@@ -8,5 +8,8 @@ namespace mbot::app {
 StageType InspectStageType();
 StageType TrajectoryWriterStageType();
 StageType MapWriterStageType();
+StageType AStarTestStageType();
+StageType MovingAiBenchmarkStageType();
+StageType ExplorationStageType();
 
 }  // namespace mbot::app

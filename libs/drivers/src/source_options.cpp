@@ -12,6 +12,7 @@
 #include "mbot/common/config.hpp"
 #include "mbot/drivers/lcm_log.hpp"
 #include "mbot/drivers/map_io.hpp"
+#include "planning_cases_source.hpp"
 #include "rawlog_source.hpp"
 
 namespace mbot::drivers {
@@ -42,9 +43,9 @@ class MapSource : public Source {
 
 SourceOptions ParseSourceOptions(config::Section& s) {
   SourceOptions o;
-  o.type = s.GetChoice("type", o.type, {"auto", "lcm_log", "rawlog", "carmen", "map"},
+  o.type = s.GetChoice("type", o.type, {"auto", "lcm_log", "rawlog", "carmen", "map", "astar_cases", "movingai"},
                        "input format; auto detects it from the file's content");
-  o.path = s.RequirePath("path", "the dataset to read (LCM log, MRPT rawlog, CARMEN log or map file)");
+  o.path = s.RequirePath("path", "the dataset to read (LCM log, MRPT rawlog, CARMEN log, map file, botlab A* poses file or folder, Moving AI .scen)");
   auto& r = o.roles;
   r.odometry = s.GetList("odometry_channels", r.odometry, "LCM channels whose poses are the robot's odometry");
   r.ground_truth = s.GetList("ground_truth_channels", r.ground_truth, "LCM channels carrying ground-truth poses");
@@ -63,6 +64,8 @@ SourceOptions ParseSourceOptions(config::Section& s) {
 }
 
 std::string DetectFormat(const std::string& path) {
+  std::string cases;
+  if (IsPlanningCasesPath(path, &cases)) return cases;
   if (!std::filesystem::is_regular_file(path)) throw std::runtime_error(path + ": no such file");
   if (IsMapFile(path)) return "map";
   const auto ends_with = [&path](const std::string& s) {
@@ -98,6 +101,7 @@ std::unique_ptr<Source> OpenSource(const SourceOptions& options) {
   if (type == "rawlog") return std::make_unique<RawlogSource>(options);
   if (type == "carmen") return std::make_unique<CarmenSource>(options);
   if (type == "map") return std::make_unique<MapSource>(options.path);
+  if (type == "astar_cases" || type == "movingai") return std::make_unique<PlanningCasesSource>(options.path, type);
   throw std::runtime_error("source type '" + type + "' is not known");
 }
 
@@ -111,6 +115,7 @@ const char* ToString(EventKind kind) {
     case EventKind::kGroundTruth: return "ground truth";
     case EventKind::kReferencePose: return "reference pose";
     case EventKind::kMap: return "map";
+    case EventKind::kPlanRequest: return "plan request";
     case EventKind::kOther: return "other";
   }
   return "?";

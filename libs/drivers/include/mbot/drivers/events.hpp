@@ -47,6 +47,17 @@ struct MotorCommand {
   double b = 0.0;
 };
 
+// A planning query from a benchmark file (botlab A* cases, Moving AI scenarios) or, live, from a
+// goal sent by a GUI. Expectations are what the file says the answer must be.
+struct PlanRequest {
+  motion::Pose2D start;
+  motion::Pose2D goal;
+  int index = 0;                 // case number within its file (0-based)
+  int expect_path = -1;          // 1: a path must exist, 0: it must not, -1: not said
+  double optimal_length_m = -1;  // the optimal path length when known, else < 0
+  int bucket = -1;               // Moving AI difficulty bucket, else -1
+};
+
 enum class EventKind {
   kLidar,          // LidarScan
   kOdometry,       // Pose2D, the robot's own dead-reckoning
@@ -56,13 +67,14 @@ enum class EventKind {
   kGroundTruth,    // Pose2D, external measurement (motion capture)
   kReferencePose,  // Pose2D from another estimator (staff SLAM, corrected CARMEN poses)
   kMap,            // shared_ptr<const OccupancyGrid>
+  kPlanRequest,    // PlanRequest, on the channel named after its map
   kOther,          // recognised but not used by the pipeline (particles, time sync, status …)
 };
 
 const char* ToString(EventKind kind);
 
 using Payload = std::variant<std::monostate, LidarScan, motion::Pose2D, EncoderTicks, Imu,
-                             MotorCommand, std::shared_ptr<const mapping::OccupancyGrid>>;
+                             MotorCommand, std::shared_ptr<const mapping::OccupancyGrid>, PlanRequest>;
 
 struct Event {
   int64_t t_us = 0;       // event (reception / log) time; the order of the stream

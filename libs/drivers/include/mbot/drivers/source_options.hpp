@@ -25,7 +25,7 @@ struct ChannelRoles {
 };
 
 struct SourceOptions {
-  std::string type = "auto";  // auto, lcm_log, rawlog, carmen, map
+  std::string type = "auto";  // auto, lcm_log, rawlog, carmen, map, astar_cases, movingai
   std::string path;           // required
   ChannelRoles roles;
   // CARMEN logs with old FLASER lines give no range limit; beams at or beyond it are no-returns.
@@ -42,7 +42,8 @@ SourceOptions ParseSourceOptions(config::Section& section);
 // Throws std::runtime_error naming the path when it cannot be read or recognised.
 std::unique_ptr<Source> OpenSource(const SourceOptions& options);
 
-// The format OpenSource would pick for `path` ("lcm_log", "rawlog", "carmen", "map").
+// The format OpenSource would pick for `path` ("lcm_log", "rawlog", "carmen", "map", "astar_cases",
+// "movingai").
 std::string DetectFormat(const std::string& path);
 
 }  // namespace mbot::drivers

@@ -1,0 +1,57 @@
+// Distance from every cell to the nearest obstacle cell, in metres: an exact Euclidean distance
+// transform (Felzenszwalb & Huttenlocher's lower-envelope pass per row and column), so the result
+// equals a brushfire whose wavefront carries the true Euclidean distance between cell centres.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "mbot/mapping/occupancy_grid.hpp"
+
+namespace mbot::planning {
+
+struct ObstacleDistanceOptions {
+  // Unknown cells (log-odds 0) count as obstacles when true, as free space when false. The botlab
+  // planner tests treat unknown as free; exploration treats it as blocked so paths stay in mapped space.
+  bool unknown_is_obstacle = false;
+  // Cells with log-odds above this are obstacles (the botlab rule is > 0).
+  int occupied_threshold = 0;
+};
+
+class ObstacleDistanceGrid {
+ public:
+  static constexpr float kInfinity = std::numeric_limits<float>::infinity();
+
+  ObstacleDistanceGrid() = default;
+  // Builds the distances for `map` (same size, resolution and origin). A map without any obstacle
+  // gives kInfinity everywhere.
+  ObstacleDistanceGrid(const mapping::OccupancyGrid& map, const ObstacleDistanceOptions& options);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  double resolution() const { return resolution_; }
+  double origin_x() const { return origin_x_; }
+  double origin_y() const { return origin_y_; }
+  bool IsInside(int cx, int cy) const { return cx >= 0 && cy >= 0 && cx < width_ && cy < height_; }
+  // Distance [m] between the centre of (cx, cy) and the centre of the nearest obstacle cell; 0 on
+  // obstacles.
+  float at(int cx, int cy) const { return dist_[static_cast<size_t>(cy) * width_ + cx]; }
+  const std::vector<float>& distances() const { return dist_; }
+  void WorldToCell(double x, double y, int* cx, int* cy) const;
+  void CellToWorld(int cx, int cy, double* x, double* y) const;
+
+ private:
+  int width_ = 0;
+  int height_ = 0;
+  double resolution_ = 0.05;
+  double origin_x_ = 0.0;
+  double origin_y_ = 0.0;
+  std::vector<float> dist_;
+};
+
+// The squared-distance transform itself, in cells², for a row-major obstacle mask (non-zero =
+// obstacle). Exposed for tests and benchmarks; cells with no obstacle anywhere get +inf.
+std::vector<float> SquaredDistanceTransform(const std::vector<uint8_t>& obstacle, int width, int height);
+
+}  // namespace mbot::planning

@@ -1,0 +1,238 @@
+#include "mbot/planning/exploration.hpp"
+
+#include <cmath>
+#include <algorithm>
+#include <cstdio>
+#include <limits>
+
+namespace mbot::planning {
+namespace {
+
+std::string Format(const char* fmt, double a, double b, double c = 0.0) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, fmt, a, b, c);
+  return buf;
+}
+
+}  // namespace
+
+const char* ToString(ExplorationState s) {
+  switch (s) {
+    case ExplorationState::kInitializing: return "initializing";
+    case ExplorationState::kExploring: return "exploring";
+    case ExplorationState::kReturningHome: return "returning home";
+    case ExplorationState::kCompleted: return "completed";
+    case ExplorationState::kFailed: return "failed";
+  }
+  return "?";
+}
+
+Explorer::Explorer(const ExplorationOptions& options) : options_(options), planner_(options.astar) {}
+
+bool Explorer::IsBlacklisted(const Frontier& f, double t_s) const {
+  for (const Blacklisted& b : blacklist_) {
+    if (t_s < b.until_s && std::hypot(f.centroid_x - b.x, f.centroid_y - b.y) <= options_.blacklist_radius_m) return true;
+  }
+  return false;
+}
+
+bool Explorer::PathIsSafe(const motion::Pose2D& pose) const {
+  if (path_.size() < 2) return true;
+  // The waypoint the robot is heading to: the end of the path segment nearest to it.
+  size_t next = 1;
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i + 1 < path_.size(); ++i) {
+    const double ax = path_[i].x, ay = path_[i].y, bx = path_[i + 1].x, by = path_[i + 1].y;
+    const double vx = bx - ax, vy = by - ay, len2 = vx * vx + vy * vy;
+    const double s = len2 > 0 ? std::clamp(((pose.x - ax) * vx + (pose.y - ay) * vy) / len2, 0.0, 1.0) : 0.0;
+    const double d = std::hypot(ax + s * vx - pose.x, ay + s * vy - pose.y);
+    if (d < best) {
+      best = d;
+      next = i + 1;
+    }
+  }
+  const double r = options_.astar.robot_radius_m;
+  for (size_t i = next; i + 1 < path_.size(); ++i) {
+    if (!planner_.SegmentIsClear(path_[i].x, path_[i].y, path_[i + 1].x, path_[i + 1].y, r)) return false;
+  }
+  return true;
+}
+
+// Plans from the robot's pose. A robot that ended up inside the robot radius of a wall (wheel slip,
+// a wall seen late) first steps to the nearest cell outside it, so it is never stranded there.
+static PlanResult PlanFrom(AStarPlanner& planner, const mapping::OccupancyGrid& map, const motion::Pose2D& pose,
+                           const motion::Pose2D& goal, double radius) {
+  if (planner.DistanceAt(pose.x, pose.y) > radius) return planner.Plan(pose, goal);
+  int cx, cy;
+  map.WorldToCell(pose.x, pose.y, &cx, &cy);
+  const int reach = static_cast<int>(std::ceil(0.3 / map.resolution()));
+  double best = std::numeric_limits<double>::infinity();
+  motion::Pose2D escape = pose;
+  for (int dy = -reach; dy <= reach; ++dy) {
+    for (int dx = -reach; dx <= reach; ++dx) {
+      double x, y;
+      map.CellToWorld(cx + dx, cy + dy, &x, &y);
+      const double d = std::hypot(x - pose.x, y - pose.y);
+      if (d < best && planner.DistanceAt(x, y) > radius) {
+        best = d;
+        escape = motion::Pose2D{x, y, pose.theta};
+      }
+    }
+  }
+  PlanResult r = planner.Plan(escape, goal);
+  if (r.status == PlanStatus::kFound) r.path.insert(r.path.begin(), pose);
+  return r;
+}
+
+void Explorer::Fail(const std::string& reason, ExplorationUpdate* u) {
+  state_ = ExplorationState::kFailed;
+  failure_reason_ = reason;
+  path_.clear();
+  u->new_path = true;
+  u->path.clear();
+  u->reason = reason;
+}
+
+bool Explorer::SelectFrontier(const mapping::OccupancyGrid& map, const motion::Pose2D& pose, double t_s,
+                              ExplorationUpdate* u) {
+  std::vector<int> unreachable;
+  const double r = options_.astar.robot_radius_m;
+  const std::vector<FrontierGoal> goals =
+      RankFrontierGoals(frontiers_, pose, map, planner_, r, options_.frontier, &unreachable);
+  for (int i : unreachable) {
+    blacklist_.push_back({frontiers_[i].centroid_x, frontiers_[i].centroid_y, t_s + options_.blacklist_s});
+  }
+  for (const FrontierGoal& g : goals) {
+    const Frontier& f = frontiers_[g.frontier];
+    const PlanResult plan = PlanFrom(planner_, map, pose, g.target, r);
+    if (plan.status != PlanStatus::kFound) {
+      blacklist_.push_back({f.centroid_x, f.centroid_y, t_s + options_.blacklist_s});
+      continue;
+    }
+    path_ = plan.path;
+    target_frontier_ = motion::Pose2D{f.centroid_x, f.centroid_y, 0.0};
+    ++replans_;
+    u->new_path = true;
+    u->path = path_;
+    u->reason += (u->reason.empty() ? "" : "; ") +
+                 Format("exploring a frontier of %.0f cells at (%.2f, %.2f)", f.size(), f.centroid_x, f.centroid_y) +
+                 Format(" with clearance %.2f m", plan.clearance_m, 0.0);
+    return true;
+  }
+  return false;
+}
+
+ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const motion::Pose2D& pose, double t_s) {
+  ExplorationUpdate u;
+  if (state_ == ExplorationState::kCompleted || state_ == ExplorationState::kFailed) {
+    u.state = state_;
+    u.reason = failure_reason_;
+    return u;
+  }
+  planner_.SetMap(ObstacleDistanceGrid(map, options_.distance));
+  int cx, cy;
+  map.WorldToCell(pose.x, pose.y, &cx, &cy);
+  if (!map.IsInside(cx, cy)) {
+    Fail(Format("the robot at (%.2f, %.2f) is off the map", pose.x, pose.y), &u);
+    u.state = state_;
+    return u;
+  }
+  if (state_ == ExplorationState::kInitializing) {
+    home_ = pose;
+    state_ = ExplorationState::kExploring;
+    u.reason = Format("home fixed at (%.2f, %.2f)", pose.x, pose.y);
+  }
+  const double radius = options_.astar.robot_radius_m;
+  auto plan_home = [&](const std::string& why) {
+    const PlanResult plan = PlanFrom(planner_, map, pose, home_, radius);
+    if (plan.status == PlanStatus::kStartInCollision) {
+      // The robot's own surroundings are not clear on this map (an early map, a wall seen late):
+      // wait for the next map rather than give up.
+      path_.clear();
+      u.new_path = true;
+      u.reason += (u.reason.empty() ? "" : "; ") + std::string("robot too close to obstacles or unknown space to plan home, waiting");
+      return;
+    }
+    if (plan.status != PlanStatus::kFound) {
+      Fail(std::string("home unreachable (") + ToString(plan.status) + ")" + (why.empty() ? "" : " " + why), &u);
+      return;
+    }
+    path_ = plan.path;
+    ++replans_;
+    u.new_path = true;
+    u.path = path_;
+    u.reason += (u.reason.empty() ? "" : "; ") + std::string("returning home") + (why.empty() ? "" : " " + why);
+  };
+
+  if (state_ == ExplorationState::kExploring) {
+    frontiers_ = FindFrontiers(map, options_.frontier);
+    std::vector<Frontier> open;
+    for (Frontier& f : frontiers_) {
+      if (!IsBlacklisted(f, t_s)) open.push_back(std::move(f));
+    }
+    frontiers_ = std::move(open);
+    bool need = path_.empty();
+    std::string why;
+    if (!need && target_frontier_) {
+      bool exists = false;
+      for (const Frontier& f : frontiers_) {
+        exists = exists || std::hypot(f.centroid_x - target_frontier_->x, f.centroid_y - target_frontier_->y) <=
+                               options_.frontier_match_m;
+      }
+      const bool reached = std::hypot(pose.x - path_.back().x, pose.y - path_.back().y) <= options_.target_reached_m;
+      if (!exists) {
+        need = true;
+        why = "target frontier explored";
+      } else if (reached) {
+        // Standing at the target and the frontier is still there: nothing more can be seen from
+        // here (unknown space the sensor cannot resolve, a gap too narrow to pass). Waiting will
+        // not change that, so it is ignored for good, unlike a frontier that was only unreachable.
+        blacklist_.push_back({target_frontier_->x, target_frontier_->y, std::numeric_limits<double>::infinity()});
+        need = true;
+        why = "frontier unresolved at its target, blacklisted";
+      }
+    }
+    if (!need && !PathIsSafe(pose)) {
+      need = true;
+      why = "path no longer safe on the updated map";
+    }
+    if (need) {
+      if (!why.empty()) u.reason += (u.reason.empty() ? "" : "; ") + why;
+      // Frontiers blacklisted just now drop out of the candidates.
+      std::vector<Frontier> open2;
+      for (Frontier& f : frontiers_) {
+        if (!IsBlacklisted(f, t_s)) open2.push_back(std::move(f));
+      }
+      frontiers_ = std::move(open2);
+      target_frontier_.reset();
+      path_.clear();
+      if (!SelectFrontier(map, pose, t_s, &u)) {
+        if (!(planner_.DistanceAt(pose.x, pose.y) > radius) && !frontiers_.empty()) {
+          // Frontiers exist but the robot cannot move on this map yet: wait for the next one.
+          u.reason += (u.reason.empty() ? "" : "; ") + std::string("robot too close to obstacles or unknown space to plan, waiting");
+        } else {
+          state_ = ExplorationState::kReturningHome;
+          plan_home("(no reachable frontier left)");
+        }
+      }
+    }
+  } else if (state_ == ExplorationState::kReturningHome) {
+    if (std::hypot(pose.x - home_.x, pose.y - home_.y) <= options_.home_tolerance_m) {
+      state_ = ExplorationState::kCompleted;
+      path_.clear();
+      u.new_path = true;
+      u.reason = Format("completed: home reached within %.3f m", std::hypot(pose.x - home_.x, pose.y - home_.y), 0.0);
+    } else if (path_.empty()) {
+      plan_home("");
+    } else if (!PathIsSafe(pose)) {
+      plan_home("(path no longer safe, replanned)");
+    } else if (std::hypot(pose.x - path_.back().x, pose.y - path_.back().y) <= options_.target_reached_m) {
+      plan_home("(end of path reached outside the home tolerance)");
+    }
+  }
+  u.state = state_;
+  if (state_ == ExplorationState::kFailed) u.reason = failure_reason_;
+  return u;
+}
+
+}  // namespace mbot::planning

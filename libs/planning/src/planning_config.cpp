@@ -1,0 +1,70 @@
+#include "mbot/planning/planning_config.hpp"
+
+#include "mbot/common/config.hpp"
+
+namespace mbot::planning {
+
+AStarOptions ParseAStarOptions(config::Section& s, const AStarOptions& d) {
+  AStarOptions o = d;
+  o.robot_radius_m = s.GetDouble("robot_radius_m", d.robot_radius_m,
+                                 "cells whose obstacle distance is at most this are never entered [m]", 0.0, 10.0);
+  o.ease_start_m = s.GetDouble("ease_start_m", d.ease_start_m,
+                               "easing: the first search asks this much more clearance than the radius [m]", 0.0, 10.0);
+  o.ease_step_m = s.GetDouble("ease_step_m", d.ease_step_m, "easing: clearance relaxed by this per failed search [m]",
+                              0.0, 10.0);
+  o.ease_max_m = s.GetDouble("ease_max_m", d.ease_max_m,
+                             "easing: relax at most this far below the first clearance, then search at the radius [m]",
+                             0.0, 10.0);
+  o.penalty_range_m = s.GetDouble("penalty_range_m", d.penalty_range_m,
+                                  "obstacle distance below which travel costs extra [m]", 0.0, 100.0);
+  o.penalty_weight = s.GetDouble("penalty_weight", d.penalty_weight,
+                                 "extra cost per cell of travel right at an obstacle (0: no penalty)", 0.0, 1e6);
+  o.penalty_exponent = s.GetDouble("penalty_exponent", d.penalty_exponent,
+                                   "shape of the penalty: weight * ((range - d) / range)^exponent", 0.1, 10.0);
+  o.node_budget = s.GetInt("node_budget", d.node_budget, "expansions allowed per search (0: unlimited)", 0);
+  const char* names[] = {"none", "collinear", "line_of_sight"};
+  const std::string prune = s.GetChoice("prune", names[static_cast<int>(d.prune)], {"none", "collinear", "line_of_sight"},
+                                        "waypoints kept: every cell, heading changes only, or line-of-sight shortcuts");
+  o.prune = prune == "none" ? PruneMode::kNone : prune == "collinear" ? PruneMode::kCollinear : PruneMode::kLineOfSight;
+  return o;
+}
+
+ObstacleDistanceOptions ParseObstacleDistanceOptions(config::Section& s, const ObstacleDistanceOptions& d) {
+  ObstacleDistanceOptions o = d;
+  o.unknown_is_obstacle = s.GetBool("unknown_is_obstacle", d.unknown_is_obstacle,
+                                    "unknown cells (log-odds 0) count as obstacles for distances and paths");
+  o.occupied_threshold = static_cast<int>(s.GetInt("occupied_threshold", d.occupied_threshold,
+                                                   "cells with log-odds above this are obstacles", -127, 126));
+  return o;
+}
+
+FrontierOptions ParseFrontierOptions(config::Section& s, const FrontierOptions& d) {
+  FrontierOptions o = d;
+  o.min_cells = static_cast<int>(s.GetInt("min_frontier_cells", d.min_cells,
+                                          "frontier regions with fewer cells are ignored", 1, 1000000));
+  o.search_radius_m = s.GetDouble("frontier_search_radius_m", d.search_radius_m,
+                                  "radius searched around a frontier's centroid for a reachable cell [m]", 0.0, 100.0);
+  return o;
+}
+
+ExplorationOptions ParseExplorationOptions(config::Section& s, const ExplorationOptions& d) {
+  ExplorationOptions o = d;
+  o.astar = ParseAStarOptions(s, d.astar);
+  o.distance = ParseObstacleDistanceOptions(s, d.distance);
+  o.frontier = ParseFrontierOptions(s, d.frontier);
+  o.home_tolerance_m = s.GetDouble("home_tolerance_m", d.home_tolerance_m,
+                                   "exploration is completed when the robot is this close to home [m]", 0.0, 10.0);
+  o.target_reached_m = s.GetDouble("target_reached_m", d.target_reached_m,
+                                   "a frontier target counts as reached this close [m]", 0.0, 10.0);
+  o.blacklist_s = s.GetDouble("blacklist_s", d.blacklist_s,
+                              "how long an unreachable or unresolvable frontier is ignored [s]", 0.0, 1e6);
+  o.blacklist_radius_m = s.GetDouble("blacklist_radius_m", d.blacklist_radius_m,
+                                     "frontiers whose centroid is this close to a blacklisted one are ignored too [m]",
+                                     0.0, 100.0);
+  o.frontier_match_m = s.GetDouble("frontier_match_m", d.frontier_match_m,
+                                   "the target frontier still exists while a frontier centroid is this close [m]", 0.0,
+                                   100.0);
+  return o;
+}
+
+}  // namespace mbot::planning

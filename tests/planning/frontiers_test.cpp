@@ -1,0 +1,61 @@
+#include "mbot/planning/frontiers.hpp"
+
+#include <gtest/gtest.h>
+
+namespace mbot::planning {
+namespace {
+
+using mapping::OccupancyGrid;
+
+TEST(FrontiersTest, BorderBetweenFreeAndUnknownGroupedIntoRegions) {
+  // Left half known free, right half unknown, except a known-free island far right.
+  OccupancyGrid g(40, 20, 0.05, 0, 0, 0);
+  for (int y = 0; y < 20; ++y) {
+    for (int x = 0; x < 20; ++x) g.at(x, y) = -100;
+  }
+  g.at(35, 10) = -100;  // a one-cell island: a frontier region of size 1
+  const std::vector<Frontier> all = FindFrontiers(g, {1, 1.0});
+  ASSERT_EQ(all.size(), 2u);
+  EXPECT_EQ(all[0].size(), 20);  // the column x = 19
+  EXPECT_NEAR(all[0].centroid_x, 19.5 * 0.05, 1e-12);
+  EXPECT_NEAR(all[0].centroid_y, 10 * 0.05, 1e-12);
+  EXPECT_EQ(all[1].size(), 1);
+  EXPECT_EQ(FindFrontiers(g, {5, 1.0}).size(), 1u);  // min_cells drops the island
+}
+
+TEST(FrontiersTest, OccupiedCellsAreNeverFrontiers) {
+  OccupancyGrid g(10, 10, 0.05, 0, 0, 0);
+  for (int y = 0; y < 10; ++y) g.at(3, y) = 100;
+  EXPECT_TRUE(FindFrontiers(g, {1, 1.0}).empty());
+}
+
+TEST(FrontiersTest, GoalIsCentroidOrNearestReachableCell) {
+  // A free room whose right side opens to unknown space; a wall segment sits on the frontier's centroid.
+  OccupancyGrid g(60, 40, 0.05, 0, 0, 0);
+  for (int y = 1; y < 39; ++y) {
+    for (int x = 1; x < 40; ++x) g.at(x, y) = -100;
+  }
+  for (int x = 0; x < 41; ++x) g.at(x, 0) = g.at(x, 39) = 100;
+  for (int y = 0; y < 40; ++y) g.at(0, y) = 100;
+  const std::vector<Frontier> f = FindFrontiers(g, {5, 1.0});
+  ASSERT_EQ(f.size(), 1u);
+  AStarPlanner planner;
+  planner.SetMap(ObstacleDistanceGrid(g, {true, 0}));
+  std::vector<int> unreachable;
+  const std::vector<FrontierGoal> goals =
+      RankFrontierGoals(f, {0.5, 1.0, 0}, g, planner, 0.10, {5, 1.0}, &unreachable);
+  ASSERT_EQ(goals.size(), 1u);
+  EXPECT_TRUE(unreachable.empty());
+  // The centroid lies on the frontier (0.05 m from unknown space): not reachable with 0.10 m
+  // clearance, so the nearest reachable cell is taken, just inside the room.
+  EXPECT_LT(goals[0].target.x, f[0].centroid_x);
+  EXPECT_NEAR(goals[0].target.x, f[0].centroid_x - 0.10, 0.03);
+  EXPECT_NEAR(goals[0].target.y, f[0].centroid_y, 0.03);
+  EXPECT_GT(goals[0].cost, 0.0);
+  // A search radius too small to get off the frontier: unreachable.
+  EXPECT_TRUE(RankFrontierGoals(f, {0.5, 1.0, 0}, g, planner, 0.10, {5, 0.05}, &unreachable).empty());
+  EXPECT_EQ(unreachable, std::vector<int>{0});
+}
+
+}  // namespace
+}  // namespace mbot::planning

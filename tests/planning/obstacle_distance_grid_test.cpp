@@ -1,0 +1,94 @@
+#include "mbot/planning/obstacle_distance_grid.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace mbot::planning {
+namespace {
+
+using mapping::OccupancyGrid;
+
+// Brute force: distance between cell centres to the nearest obstacle cell.
+float BruteForce(const OccupancyGrid& g, int x, int y, bool unknown_is_obstacle) {
+  float best = ObstacleDistanceGrid::kInfinity;
+  for (int oy = 0; oy < g.height(); ++oy) {
+    for (int ox = 0; ox < g.width(); ++ox) {
+      const int c = g.at(ox, oy);
+      if (c > 0 || (unknown_is_obstacle && c == 0)) {
+        best = std::min(best, static_cast<float>(std::hypot(ox - x, oy - y) * g.resolution()));
+      }
+    }
+  }
+  return best;
+}
+
+TEST(ObstacleDistanceGridTest, SingleObstacleGivesEuclideanDistances) {
+  OccupancyGrid g(9, 7, 0.05, -1.0, 2.0, -127);
+  g.at(4, 3) = 127;
+  ObstacleDistanceGrid d(g, {});
+  EXPECT_EQ(d.at(4, 3), 0.0f);
+  EXPECT_NEAR(d.at(5, 3), 0.05, 1e-6);
+  EXPECT_NEAR(d.at(5, 4), 0.05 * std::sqrt(2.0), 1e-6);
+  EXPECT_NEAR(d.at(0, 0), 0.05 * std::hypot(4, 3), 1e-6);  // 0.25 m, not the 4-or-8-neighbour brushfire value
+  EXPECT_NEAR(d.at(8, 6), 0.25, 1e-6);
+  EXPECT_EQ(d.origin_x(), -1.0);
+  EXPECT_EQ(d.resolution(), 0.05);
+}
+
+// The botlab obstacle_distance_grid check: a square wall in a 25×25 grid; inside and outside, the
+// distance is the distance to the nearest wall cell.
+TEST(ObstacleDistanceGridTest, BotlabSquareWall) {
+  OccupancyGrid g(25, 25, 0.05, 0.0, 0.0, -50);
+  for (int i = 5; i <= 19; ++i) {
+    g.at(i, 5) = g.at(i, 19) = g.at(5, i) = g.at(19, i) = 100;
+  }
+  ObstacleDistanceGrid d(g, {});
+  for (int y = 0; y < 25; ++y) {
+    for (int x = 0; x < 25; ++x) {
+      ASSERT_NEAR(d.at(x, y), BruteForce(g, x, y, false), 1e-6) << x << "," << y;
+    }
+  }
+  EXPECT_NEAR(d.at(12, 12), 7 * 0.05, 1e-6);  // centre: 7 cells from every wall
+  EXPECT_EQ(d.at(5, 10), 0.0f);
+  EXPECT_NEAR(d.at(0, 0), 0.05 * std::hypot(5, 5), 1e-6);
+}
+
+TEST(ObstacleDistanceGridTest, MatchesBruteForceOnRandomGrids) {
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 20; ++trial) {
+    const int w = 5 + rng() % 40, h = 5 + rng() % 40;
+    OccupancyGrid g(w, h, 0.1, 0.0, 0.0);
+    for (auto& c : g.cells()) {
+      const int r = rng() % 100;
+      c = r < 8 ? 100 : r < 15 ? 0 : -100;
+    }
+    for (bool unknown : {false, true}) {
+      ObstacleDistanceGrid d(g, {unknown, 0});
+      for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) ASSERT_NEAR(d.at(x, y), BruteForce(g, x, y, unknown), 1e-5);
+      }
+    }
+  }
+}
+
+TEST(ObstacleDistanceGridTest, NoObstacleIsInfinite) {
+  OccupancyGrid g(10, 4, 0.05, 0, 0, -127);
+  ObstacleDistanceGrid d(g, {});
+  EXPECT_TRUE(std::isinf(d.at(3, 2)));
+  // Unknown cells block when asked to.
+  g.at(0, 0) = 0;
+  ObstacleDistanceGrid d2(g, {true, 0});
+  EXPECT_NEAR(d2.at(3, 0), 0.15, 1e-6);
+}
+
+TEST(ObstacleDistanceGridTest, OccupiedThresholdIsStrict) {
+  OccupancyGrid g(3, 1, 1.0, 0, 0, -127);
+  g.at(0, 0) = 10;
+  EXPECT_EQ(ObstacleDistanceGrid(g, {false, 0}).at(2, 0), 2.0f);
+  EXPECT_TRUE(std::isinf(ObstacleDistanceGrid(g, {false, 10}).at(2, 0)));
+}
+
+}  // namespace
+}  // namespace mbot::planning
