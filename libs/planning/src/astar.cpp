@@ -79,6 +79,21 @@ struct AStarPlanner::Impl {
     *cy = static_cast<int>(std::floor((y - origin_y) / resolution));
     return *cx >= 0 && *cy >= 0 && *cx < width && *cy < height;
   }
+  // Start and goal cells (padded indices), checked in order: on the map, then clearer than `limit`.
+  // Returns false with the status to report.
+  bool Endpoints(const motion::Pose2D& start, const motion::Pose2D& goal, float limit, int* s, int* g,
+                 PlanStatus* status) const {
+    if (width == 0) throw std::logic_error("AStarPlanner: Plan called before SetMap");
+    int sx, sy, gx, gy;
+    if (!ToCell(start.x, start.y, &sx, &sy)) return *status = PlanStatus::kStartOffMap, false;
+    if (!ToCell(goal.x, goal.y, &gx, &gy)) return *status = PlanStatus::kGoalOffMap, false;
+    *s = Index(sx, sy);
+    *g = Index(gx, gy);
+    if (!(dist[*s] > limit)) return *status = PlanStatus::kStartInCollision, false;
+    if (!(dist[*g] > limit)) return *status = PlanStatus::kGoalInCollision, false;
+    return true;
+  }
+
   void NextGeneration() {
     if (generation >= 0x7fffffffu) {
       for (Node& n : nodes) n.mark = 0;
@@ -314,16 +329,10 @@ std::vector<motion::Pose2D> HeadingsAlong(std::vector<motion::Pose2D> path) {
 
 PlanResult AStarPlanner::PlanAtClearance(const motion::Pose2D& start, const motion::Pose2D& goal, double clearance_m) {
   Impl& m = *impl_;
-  if (!has_map()) throw std::logic_error("AStarPlanner: Plan called before SetMap");
   PlanResult r;
-  int sx, sy, gx, gy;
-  if (!m.ToCell(start.x, start.y, &sx, &sy)) return r.status = PlanStatus::kStartOffMap, r;
-  if (!m.ToCell(goal.x, goal.y, &gx, &gy)) return r.status = PlanStatus::kGoalOffMap, r;
-  const int s = m.Index(sx, sy), g = m.Index(gx, gy);
-  const float hard = static_cast<float>(options_.robot_radius_m);
+  int s, g;
   const float c = static_cast<float>(clearance_m);
-  if (!(m.dist[s] > std::min(hard, c))) return r.status = PlanStatus::kStartInCollision, r;
-  if (!(m.dist[g] > std::min(hard, c))) return r.status = PlanStatus::kGoalInCollision, r;
+  if (!m.Endpoints(start, goal, std::min(static_cast<float>(options_.robot_radius_m), c), &s, &g, &r.status)) return r;
   r.clearance_m = clearance_m;
   if (s == g) {
     r.status = PlanStatus::kFound;
@@ -391,15 +400,9 @@ PlanResult AStarPlanner::PlanAtClearance(const motion::Pose2D& start, const moti
 
 PlanResult AStarPlanner::Plan(const motion::Pose2D& start, const motion::Pose2D& goal) {
   Impl& m = *impl_;
-  if (!has_map()) throw std::logic_error("AStarPlanner: Plan called before SetMap");
   PlanResult r;
-  int sx, sy, gx, gy;
-  if (!m.ToCell(start.x, start.y, &sx, &sy)) return r.status = PlanStatus::kStartOffMap, r;
-  if (!m.ToCell(goal.x, goal.y, &gx, &gy)) return r.status = PlanStatus::kGoalOffMap, r;
-  const int s = m.Index(sx, sy), g = m.Index(gx, gy);
-  const float hard = static_cast<float>(options_.robot_radius_m);
-  if (!(m.dist[s] > hard)) return r.status = PlanStatus::kStartInCollision, r;
-  if (!(m.dist[g] > hard)) return r.status = PlanStatus::kGoalInCollision, r;
+  int s, g;
+  if (!m.Endpoints(start, goal, static_cast<float>(options_.robot_radius_m), &s, &g, &r.status)) return r;
   int64_t expansions = 0;
   int searches = 0;
   for (double c : EasingClearances()) {
