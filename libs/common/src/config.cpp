@@ -8,17 +8,12 @@
 #include <fstream>
 #include <sstream>
 
+#include "mbot/common/strings.hpp"
+
 namespace fs = std::filesystem;
 
 namespace mbot::config {
 namespace {
-
-std::string Trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return "";
-  const auto e = s.find_last_not_of(" \t\r\n");
-  return s.substr(b, e - b + 1);
-}
 
 // Drops a comment that starts a line, or an inline one that follows whitespace (`key = 1  # why`).
 std::string StripComment(const std::string& line) {

@@ -1,5 +1,6 @@
 #include "mbot/drivers/map_io.hpp"
 
+
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/serialization/CArchive.h>
@@ -14,6 +15,7 @@
 #include <stdexcept>
 
 #include "mbot/common/atomic_file.hpp"
+#include "mbot/common/strings.hpp"
 
 namespace fs = std::filesystem;
 
@@ -30,12 +32,6 @@ std::string ShortestDouble(double v) {
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-std::string Trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t\r\n") - b + 1);
 }
 
 }  // namespace

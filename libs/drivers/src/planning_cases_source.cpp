@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "mbot/common/strings.hpp"
 #include "mbot/drivers/map_io.hpp"
 
 namespace mbot::drivers {
@@ -18,13 +19,6 @@ bool EndsWith(const std::string& s, const std::string& suffix) {
 
 [[noreturn]] void Fail(const std::string& path, int line, const std::string& what) {
   throw std::runtime_error(path + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " + what);
-}
-
-std::string Trimmed(std::string s) {
-  while (!s.empty() && (s.back() == '\r' || s.back() == ' ' || s.back() == '\t')) s.pop_back();
-  size_t i = 0;
-  while (i < s.size() && (s[i] == ' ' || s[i] == '\t')) ++i;
-  return s.substr(i);
 }
 
 // botlab: first line N, then N lines "start_x start_y goal_x goal_y should_exist".
@@ -41,7 +35,7 @@ void ReadBotlabCases(const std::string& poses_path, std::vector<Event>* out) {
   int line_no = 0, declared = -1, read = 0;
   while (std::getline(in, line)) {
     ++line_no;
-    line = Trimmed(line);
+    line = Trim(line);
     if (line.empty()) continue;
     std::istringstream s(line);
     if (declared < 0) {
@@ -76,7 +70,7 @@ void ReadMovingAiScenarios(const std::string& scen_path, std::vector<Event>* out
   int index = 0;
   while (std::getline(in, line)) {
     ++line_no;
-    line = Trimmed(line);
+    line = Trim(line);
     if (line.empty()) continue;
     if (line_no == 1 && line.rfind("version", 0) == 0) continue;
     std::istringstream s(line);

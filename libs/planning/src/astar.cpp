@@ -389,8 +389,7 @@ PlanResult AStarPlanner::PlanAtClearance(const motion::Pose2D& start, const moti
         out.push_back(path[next]);
         anchor = next;
       }
-      path = HeadingsAlong(std::move(out));
-      path.back().theta = goal.theta;
+      path = HeadingsAlong(std::move(out));  // keeps the goal's own heading on the last pose
       break;
     }
   }

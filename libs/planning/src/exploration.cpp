@@ -165,12 +165,13 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
   };
 
   if (state_ == ExplorationState::kExploring) {
+    auto drop_blacklisted = [&] {
+      frontiers_.erase(std::remove_if(frontiers_.begin(), frontiers_.end(),
+                                      [&](const Frontier& f) { return IsBlacklisted(f, t_s); }),
+                       frontiers_.end());
+    };
     frontiers_ = FindFrontiers(map, options_.frontier);
-    std::vector<Frontier> open;
-    for (Frontier& f : frontiers_) {
-      if (!IsBlacklisted(f, t_s)) open.push_back(std::move(f));
-    }
-    frontiers_ = std::move(open);
+    drop_blacklisted();
     bool need = path_.empty();
     std::string why;
     if (!need && target_frontier_) {
@@ -198,12 +199,7 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
     }
     if (need) {
       if (!why.empty()) u.reason += (u.reason.empty() ? "" : "; ") + why;
-      // Frontiers blacklisted just now drop out of the candidates.
-      std::vector<Frontier> open2;
-      for (Frontier& f : frontiers_) {
-        if (!IsBlacklisted(f, t_s)) open2.push_back(std::move(f));
-      }
-      frontiers_ = std::move(open2);
+      drop_blacklisted();  // the frontier blacklisted just now drops out of the candidates
       target_frontier_.reset();
       path_.clear();
       if (!SelectFrontier(map, pose, t_s, &u)) {
