@@ -7,7 +7,8 @@ namespace mbot::app {
 const std::vector<StageType>& StageTypes() {
   static const std::vector<StageType> types = [] {
     std::vector<StageType> t = {InspectStageType(), TrajectoryWriterStageType(), MapWriterStageType(),
-                                   AStarTestStageType(), MovingAiBenchmarkStageType(), ExplorationStageType()};
+                                   AStarTestStageType(), MovingAiBenchmarkStageType(), ExplorationStageType(),
+                                   SlamStageType()};
     std::sort(t.begin(), t.end(), [](const StageType& a, const StageType& b) { return a.name < b.name; });
     return t;
   }();

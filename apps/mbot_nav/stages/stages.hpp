@@ -11,5 +11,6 @@ StageType MapWriterStageType();
 StageType AStarTestStageType();
 StageType MovingAiBenchmarkStageType();
 StageType ExplorationStageType();
+StageType SlamStageType();
 
 }  // namespace mbot::app

@@ -106,11 +106,14 @@ bool DecodeLidar(const uint8_t* d, size_t n, Event* ev, std::string* err) {
   scan.angles_rad = std::move(m.thetas);
   scan.beam_times_us = std::move(m.times);
   scan.intensities = std::move(m.intensities);
-  for (float a : scan.angles_rad) {
+  // lidar_t thetas grow clockwise (the RPLidar's own convention, which the botlab code undoes with
+  // θ_robot − θ_beam); events carry counter-clockwise angles, so negate them once here.
+  for (float& a : scan.angles_rad) {
     if (!std::isfinite(a)) {
       *err = "non-finite beam angle";
       return false;
     }
+    a = -a;
   }
   ev->kind = EventKind::kLidar;
   ev->stamp_us = m.utime;

@@ -10,7 +10,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <octomap/OcTree.h>
+
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
 
@@ -240,6 +243,67 @@ void WriteMapPng(const mapping::OccupancyGrid& g, const std::string& path) {
   const std::string tmp = TempPathFor(path);
   if (!cv::imwrite(tmp, img)) Fail(path, "cannot write PNG");
   CommitFile(tmp, path);
+}
+
+void WriteMapPngWithOverlays(const mapping::OccupancyGrid& g, const std::vector<MapOverlay>& overlays, int scale,
+                             const std::string& path) {
+  scale = std::max(1, scale);
+  cv::Mat gray(g.height(), g.width(), CV_8UC1);
+  for (int y = 0; y < g.height(); ++y) {
+    uint8_t* row = gray.ptr<uint8_t>(g.height() - 1 - y);
+    for (int x = 0; x < g.width(); ++x) row[x] = static_cast<uint8_t>(127 - int(g.at(x, y)));
+  }
+  cv::Mat img;
+  cv::cvtColor(gray, img, cv::COLOR_GRAY2BGR);
+  if (scale > 1) cv::resize(img, img, cv::Size(), scale, scale, cv::INTER_NEAREST);
+  auto pixel = [&](const motion::Pose2D& p) {
+    const double px = (p.x - g.origin_x()) / g.resolution() * scale;
+    const double py = (g.height() - (p.y - g.origin_y()) / g.resolution()) * scale;
+    return cv::Point(static_cast<int>(std::lround(px)), static_cast<int>(std::lround(py)));
+  };
+  int legend_y = 14;
+  for (const MapOverlay& o : overlays) {
+    const cv::Scalar colour(o.b, o.g, o.r);
+    if (o.points) {
+      for (const motion::Pose2D& p : o.poses) cv::circle(img, pixel(p), 1, colour, cv::FILLED);
+    } else if (o.poses.size() > 1) {
+      std::vector<cv::Point> line;
+      line.reserve(o.poses.size());
+      for (const motion::Pose2D& p : o.poses) line.push_back(pixel(p));
+      cv::polylines(img, line, false, colour, 1, cv::LINE_AA);
+    }
+    if (!o.label.empty()) {
+      cv::line(img, cv::Point(6, legend_y - 4), cv::Point(22, legend_y - 4), colour, 2);
+      cv::putText(img, o.label, cv::Point(26, legend_y), cv::FONT_HERSHEY_SIMPLEX, 0.4, colour, 1, cv::LINE_AA);
+      legend_y += 14;
+    }
+  }
+  const std::string tmp = TempPathFor(path);
+  if (!cv::imwrite(tmp, img)) Fail(path, "cannot write PNG");
+  CommitFile(tmp, path);
+}
+
+void WriteOctomap(const mapping::OccupancyGrid& g, double wall_height_m, const std::string& path) {
+  const double res = g.resolution();
+  octomap::OcTree tree(res);
+  const int layers = std::max(1, static_cast<int>(std::ceil(wall_height_m / res)));
+  for (int y = 0; y < g.height(); ++y) {
+    for (int x = 0; x < g.width(); ++x) {
+      const int8_t v = g.at(x, y);
+      if (v == 0) continue;
+      double wx, wy;
+      g.CellToWorld(x, y, &wx, &wy);
+      if (v > 0) {
+        for (int k = 0; k < layers; ++k) tree.updateNode(octomap::point3d(wx, wy, (k + 0.5) * res), true, true);
+      } else {
+        tree.updateNode(octomap::point3d(wx, wy, 0.5 * res), false, true);
+      }
+    }
+  }
+  tree.updateInnerOccupancy();
+  mbot::WriteFileAtomically(path, [&](std::ostream& out) {
+    if (!tree.writeBinary(out)) throw std::runtime_error(path + ": cannot serialise the OctoMap");
+  });
 }
 
 bool IsMapFile(const std::string& path) {

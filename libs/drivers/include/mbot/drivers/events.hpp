@@ -15,7 +15,7 @@ namespace mbot::drivers {
 
 struct LidarScan {
   std::vector<float> ranges_m;          // <= 0 or NaN: no return
-  std::vector<float> angles_rad;        // per beam, in the sensor frame (may run 2π → 0)
+  std::vector<float> angles_rad;        // per beam, counter-clockwise in the sensor frame (any 2π range)
   std::vector<int64_t> beam_times_us;   // per beam when the source has them, else empty
   std::vector<float> intensities;       // empty when absent
   float max_range_m = 0.0f;             // 0 when the source does not say

@@ -2,9 +2,12 @@
 // Moving AI `.map`, and PNG pictures. Readers throw std::runtime_error naming the file (and line).
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "mbot/mapping/occupancy_grid.hpp"
+#include "mbot/motion/pose2d.hpp"
 
 namespace mbot::drivers {
 
@@ -32,6 +35,22 @@ mapping::OccupancyGrid ReadMovingAiMap(const std::string& path);
 
 // A picture for people: occupied dark, free light, unknown grey, graded by log-odds; top = +y.
 void WriteMapPng(const mapping::OccupancyGrid& grid, const std::string& path);
+
+// Something drawn over a map picture: a path (a polyline through the poses) or a set of points.
+struct MapOverlay {
+  std::vector<motion::Pose2D> poses;
+  uint8_t r = 0, g = 0, b = 0;
+  bool points = false;  // dots instead of a polyline
+  std::string label;    // shown in the legend when non-empty
+};
+
+// The map picture in colour, `scale` pixels per cell, with the overlays drawn in order and a legend.
+void WriteMapPngWithOverlays(const mapping::OccupancyGrid& grid, const std::vector<MapOverlay>& overlays,
+                             int scale, const std::string& path);
+
+// An OctoMap (.bt) of the grid for 3D viewers: occupied cells become columns from z = 0 to
+// `wall_height_m`, free cells a free floor layer, at the grid's resolution.
+void WriteOctomap(const mapping::OccupancyGrid& grid, double wall_height_m, const std::string& path);
 
 // True when `path` has the extension of a map format ReadAnyMap reads.
 bool IsMapFile(const std::string& path);

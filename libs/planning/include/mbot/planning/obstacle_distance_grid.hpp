@@ -50,8 +50,4 @@ class ObstacleDistanceGrid {
   std::vector<float> dist_;
 };
 
-// The squared-distance transform itself, in cells², for a row-major obstacle mask (non-zero =
-// obstacle). Exposed for tests and benchmarks; cells with no obstacle anywhere get +inf.
-std::vector<float> SquaredDistanceTransform(const std::vector<uint8_t>& obstacle, int width, int height);
-
 }  // namespace mbot::planning

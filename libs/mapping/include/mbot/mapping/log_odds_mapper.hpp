@@ -1,0 +1,50 @@
+// Log-odds occupancy mapping: every ray lowers the cells it crosses (Bresenham) by `miss_odds` and,
+// when it hit something, raises its end cell by `hit_odds`, saturating at ±127. The grid either
+// keeps a fixed extent or grows (by whole blocks, keeping its cells) when a scan reaches its edge.
+#pragma once
+
+#include <vector>
+
+#include "mbot/mapping/moving_scan.hpp"
+#include "mbot/mapping/occupancy_grid.hpp"
+#include "mbot/motion/pose2d.hpp"
+
+namespace mbot::mapping {
+
+struct MapperOptions {
+  int hit_odds = 5;     // the seed report's choice (sharpest walls on the botlab logs)
+  int miss_odds = 1;
+  double resolution_m = 0.05;
+  // Initial extent, centred on (center_x_m, center_y_m).
+  double width_m = 10.0;
+  double height_m = 10.0;
+  double center_x_m = 0.0;
+  double center_y_m = 0.0;
+  bool grow = true;          // false: rays leaving the extent are clipped
+  double grow_block_m = 5.0; // the extent grows by multiples of this
+};
+
+class LogOddsMapper {
+ public:
+  explicit LogOddsMapper(const MapperOptions& options);
+  // Starts from an existing map (its extent and resolution replace the options').
+  void Reset(OccupancyGrid map);
+
+  // Inserts rays given in the frame of `robot_pose` (see DeskewScan).
+  void Insert(const std::vector<ScanRay>& rays, const motion::Pose2D& robot_pose);
+
+  const OccupancyGrid& map() const { return map_; }
+  int grow_count() const { return grow_count_; }
+
+ private:
+  void EnsureCovers(double min_x, double min_y, double max_x, double max_y);
+
+  MapperOptions options_;
+  OccupancyGrid map_;
+  int grow_count_ = 0;
+};
+
+// Cells on the segment between two cells, both ends included, in order (Bresenham).
+void BresenhamLine(int x0, int y0, int x1, int y1, std::vector<int>* xs, std::vector<int>* ys);
+
+}  // namespace mbot::mapping

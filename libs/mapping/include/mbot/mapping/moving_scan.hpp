@@ -1,0 +1,33 @@
+// A lidar scan taken while the robot moves, turned into rays in the frame of the robot's pose at
+// the end of the scan: each beam's sensor pose is interpolated between the robot's poses at the
+// scan's start and end, so a particle only has to apply one rigid transform to every ray.
+#pragma once
+
+#include <vector>
+
+#include "mbot/motion/pose2d.hpp"
+
+namespace mbot::mapping {
+
+struct ScanRay {
+  float ox = 0, oy = 0;  // where the beam left the sensor
+  float ex = 0, ey = 0;  // its end point (the return, or the end of the cleared span)
+  bool hit = false;      // false: max-range or no-return beam, clears space but marks no obstacle
+};
+
+struct ScanOptions {
+  double min_range_m = 0.10;   // shorter returns hit the robot itself and are dropped
+  double max_range_m = 0.0;    // returns at or beyond this are misses; 0: the sensor's own maximum
+  double no_return_clear_m = 0.0;  // a beam with no return clears this far; 0: not at all
+};
+
+// ranges, angles (counter-clockwise, sensor frame) and fractions (each beam's time within the scan,
+// 0 = start, 1 = end) have one entry per beam. `start_in_end` is the robot's pose at the scan start
+// expressed in the frame of its pose at the scan end; `sensor` is the sensor's pose on the robot.
+// `sensor_max_range_m` is what the sensor reported (0 when unknown).
+std::vector<ScanRay> DeskewScan(const std::vector<float>& ranges, const std::vector<float>& angles,
+                                const std::vector<float>& fractions, const motion::Pose2D& start_in_end,
+                                const motion::Pose2D& sensor, double sensor_max_range_m,
+                                const ScanOptions& options);
+
+}  // namespace mbot::mapping

@@ -1,0 +1,76 @@
+// One SLAM system for all four modes the stack runs:
+//   mapping-only  poses come from outside (motion capture, a reference channel); scans build the map;
+//   action-only   particles follow odometry through the action model alone; scans build the map;
+//   localization  particles weighed against a known map, which is not changed;
+//   full SLAM     localization against the map built so far, then the scan is added at the estimate.
+// Between filter updates (the robot has not moved enough) the pose follows odometry.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "mbot/mapping/action_model.hpp"
+#include "mbot/mapping/log_odds_mapper.hpp"
+#include "mbot/mapping/moving_scan.hpp"
+#include "mbot/mapping/particle_filter.hpp"
+#include "mbot/mapping/sensor_model.hpp"
+
+namespace mbot::mapping {
+
+enum class SlamMode { kMappingOnly, kActionOnly, kLocalization, kFullSlam };
+const char* ToString(SlamMode mode);
+
+struct SlamOptions {
+  SlamMode mode = SlamMode::kFullSlam;
+  MapperOptions mapper;
+  ActionModelOptions action;
+  SensorModelOptions sensor;
+  ParticleFilterOptions filter;
+};
+
+struct SlamStep {
+  motion::Pose2D pose;
+  bool filter_updated = false;  // the particle filter ran on this scan
+  FilterStatus status;          // the filter's state after this scan (when it has one)
+};
+
+class Slam {
+ public:
+  Slam(const SlamOptions& options, uint64_t seed);
+
+  // The known map (localization; also a starting map for full SLAM).
+  void SetMap(OccupancyGrid map);
+  // Starts at `pose`, with `odometry` the odometry reading at that moment.
+  void Initialize(const motion::Pose2D& pose, const motion::Pose2D& odometry, double sigma_xy_m = 0.0,
+                  double sigma_theta_rad = 0.0);
+  // Starts with particles spread over the known map's free space (localization only).
+  void InitializeGlobal(const motion::Pose2D& odometry);
+  bool initialized() const { return initialized_; }
+
+  // One scan, its rays in the frame of the robot at the scan's end; `odometry` is the odometry pose
+  // at that time; `reference` the externally given pose (mapping-only; ignored otherwise).
+  SlamStep ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2D& odometry,
+                       const motion::Pose2D* reference = nullptr);
+
+  const OccupancyGrid& map() const { return mapper_.map(); }
+  const ParticleFilter& filter() const { return filter_; }
+  const SlamOptions& options() const { return options_; }
+  int64_t filter_updates() const { return filter_.updates(); }
+
+ private:
+  bool UsesFilter() const { return options_.mode != SlamMode::kMappingOnly; }
+
+  SlamOptions options_;
+  LogOddsMapper mapper_;
+  ActionModel action_;
+  SensorModel sensor_;
+  SensorModel no_map_sensor_;  // action-only: every particle weighs the same
+  ParticleFilter filter_;
+  bool initialized_ = false;
+  bool sensor_stale_ = true;
+  motion::Pose2D last_odometry_;   // odometry at the last filter update
+  motion::Pose2D last_estimate_;   // the estimate then
+};
+
+}  // namespace mbot::mapping

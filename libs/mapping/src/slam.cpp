@@ -1,0 +1,84 @@
+#include "mbot/mapping/slam.hpp"
+
+#include <stdexcept>
+
+namespace mbot::mapping {
+
+const char* ToString(SlamMode mode) {
+  switch (mode) {
+    case SlamMode::kMappingOnly: return "mapping-only";
+    case SlamMode::kActionOnly: return "action-only";
+    case SlamMode::kLocalization: return "localization";
+    case SlamMode::kFullSlam: return "full SLAM";
+  }
+  return "?";
+}
+
+Slam::Slam(const SlamOptions& options, uint64_t seed)
+    : options_(options),
+      mapper_(options.mapper),
+      action_(options.action),
+      sensor_(options.sensor),
+      no_map_sensor_(options.sensor),
+      filter_(options.filter, seed) {}
+
+void Slam::SetMap(OccupancyGrid map) {
+  mapper_.Reset(std::move(map));
+  sensor_stale_ = true;
+  filter_.SetFreeSpace(mapper_.map());
+}
+
+void Slam::Initialize(const motion::Pose2D& pose, const motion::Pose2D& odometry, double sigma_xy_m,
+                      double sigma_theta_rad) {
+  filter_.InitializeAt(pose, sigma_xy_m, sigma_theta_rad);
+  last_odometry_ = odometry;
+  last_estimate_ = pose;
+  initialized_ = true;
+}
+
+void Slam::InitializeGlobal(const motion::Pose2D& odometry) {
+  if (options_.mode != SlamMode::kLocalization) {
+    throw std::logic_error("global localization needs localization mode and a known map");
+  }
+  filter_.InitializeGlobal();
+  last_odometry_ = odometry;
+  last_estimate_ = filter_.status().pose;
+  initialized_ = true;
+}
+
+SlamStep Slam::ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2D& odometry,
+                           const motion::Pose2D* reference) {
+  if (!initialized_) throw std::logic_error("SLAM: ProcessScan before Initialize");
+  SlamStep out;
+  if (options_.mode == SlamMode::kMappingOnly) {
+    if (!reference) throw std::invalid_argument("mapping-only SLAM needs a reference pose per scan");
+    out.pose = *reference;
+    mapper_.Insert(rays, out.pose);
+    return out;
+  }
+  // The filter moves only once odometry moved enough; in between the pose follows odometry.
+  const bool moved = action_.Moved(last_odometry_, odometry) || !filter_.status().converged;
+  if (moved) {
+    const bool weigh = options_.mode == SlamMode::kLocalization || options_.mode == SlamMode::kFullSlam;
+    if (weigh && sensor_stale_) {
+      sensor_.SetMap(mapper_.map());
+      sensor_stale_ = false;
+    }
+    const SensorModel& model = weigh ? sensor_ : no_map_sensor_;
+    const ScanPoints points = model.Prepare(rays);
+    const OdometryStep step = ActionModel::StepBetween(last_odometry_, odometry);
+    filter_.Update(action_, step, model, points);
+    last_odometry_ = odometry;
+    last_estimate_ = filter_.status().pose;
+    out.filter_updated = true;
+  }
+  out.status = filter_.status();
+  out.pose = last_estimate_.Compose(last_odometry_.Inverse().Compose(odometry));
+  if (options_.mode != SlamMode::kLocalization) {
+    mapper_.Insert(rays, out.pose);
+    sensor_stale_ = true;
+  }
+  return out;
+}
+
+}  // namespace mbot::mapping
