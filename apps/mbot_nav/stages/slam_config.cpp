@@ -133,6 +133,7 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
   f.alpha_fast = s.GetDouble("alpha_fast", f.alpha_fast, "augmented MCL: short-term fit average rate", 0.0, 1.0);
   f.max_injection = s.GetDouble("max_injection", f.max_injection, "augmented MCL: largest share replaced per update", 0.0, 1.0);
   f.lost_inlier_fraction = s.GetDouble("lost_inlier_fraction", f.lost_inlier_fraction, "lost when the estimate's inlier share stays below this", 0.0, 1.0);
+  f.lost_fit_ratio = s.GetDouble("lost_fit_ratio", f.lost_fit_ratio, "... or the short-term scan fit below this share of the long-term one", 0.0, 1.0);
   f.lost_scans = static_cast<int>(s.GetInt("lost_scans", f.lost_scans, "... for this many updates in a row", 1, 1000000));
   f.relocalize_when_lost = s.GetBool("relocalize_when_lost", m.mode == mapping::SlamMode::kLocalization,
                                      "localization: spread the particles over the map again when lost");

@@ -71,6 +71,7 @@ class SlamStage : public Stage {
                       std::to_string(slam_.map().width()) + "x" + std::to_string(slam_.map().height()) + ")");
     }
     if (options_.encoder_odometry) wheel_odometry_.emplace(options_.wheels);
+    consistency_model_ = mapping::SensorModel(options_.slam.sensor);
     wall_start_ = std::chrono::steady_clock::now();
   }
 
@@ -249,6 +250,7 @@ class SlamStage : public Stage {
     }
     const bool mapping_only = options_.slam.mode == mapping::SlamMode::kMappingOnly;
     const mapping::SlamStep step = slam_.ProcessScan(rays, end_pose, mapping_only ? &end_pose : nullptr);
+    if (scan_points_.size() < kMaxKeptScans) scan_points_.push_back(consistency_model_.Prepare(rays));
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall0).count();
 
     ScanRecord r;
@@ -364,6 +366,16 @@ class SlamStage : public Stage {
     }
     WriteTum(dir + "slam.tum", std::string("SLAM (") + mapping::ToString(options_.slam.mode) + ")", slam_path);
     WriteTum(dir + "odometry.tum", "odometry at the scan times", odometry_path);
+    WriteFileAtomically(dir + "slam_scans.csv", [&](std::ostream& o) {
+      o << "t_s,x,y,theta,filter_updated,particles,ess,spread_m,inlier_fraction,fit_ratio,injected,lost,converged,update_ms\n";
+      char line[256];
+      for (const ScanRecord& r : records_) {
+        std::snprintf(line, sizeof line, "%.6f,%.4f,%.4f,%.5f,%d,%d,%.1f,%.4f,%.3f,%.3f,%d,%d,%d,%.3f\n", r.t_us * 1e-6, r.slam.x,
+                      r.slam.y, r.slam.theta, r.updated, r.status.particles, r.status.ess, r.status.spread_m,
+                      r.status.inlier_fraction, r.status.fit_ratio, r.status.injected, r.status.lost, r.status.converged, r.update_ms);
+        o << line;
+      }
+    });
     if (!truth_path.empty()) WriteTum(dir + "ground_truth.tum", truth_name + " at the scan times", truth_path);
 
     const mapping::OccupancyGrid& map = slam_.map();
@@ -385,6 +397,15 @@ class SlamStage : public Stage {
     overlays.push_back({poses_of(slam_path), 0, 60, 255, false, "SLAM"});
     drivers::WriteMapPngWithOverlays(map, overlays, options_.png_scale, base + ".png");
 
+    // Map sharpness: the share of every scan's returns that end within inlier_distance_m of an
+    // obstacle of the final map, at the pose the scan was given (blurred or doubled walls lower it).
+    double consistency = NAN;
+    if (!scan_points_.empty()) {
+      consistency_model_.SetMap(map);
+      double sum = 0;
+      for (size_t i = 0; i < scan_points_.size(); ++i) sum += consistency_model_.InlierFraction(records_[i].slam, scan_points_[i]);
+      consistency = sum / scan_points_.size();
+    }
     // Metrics.
     std::vector<double> update_ms, filter_ms, ess;
     int updates = 0;
@@ -407,7 +428,8 @@ class SlamStage : public Stage {
     if (!est_paired.empty()) {
       const auto ate = [&](const std::vector<Pose2D>& e, const std::vector<Pose2D>& t) {
         return "{\"aligned\": " + AteJson(motion::ComputeAte(e, t, motion::AteAlignment::kBestFitSE2)) +
-               ",\n    \"anchored\": " + AteJson(motion::ComputeAte(e, t, motion::AteAlignment::kFirstPose)) + "}";
+               ",\n    \"anchored\": " + AteJson(motion::ComputeAte(e, t, motion::AteAlignment::kFirstPose)) +
+               ",\n    \"unaligned\": " + AteJson(motion::ComputeAte(e, t, motion::AteAlignment::kNone)) + "}";
       };
       j << ",\n  \"slam_ate\": " << ate(est_paired, truth_paired) << ",\n  \"odometry_ate\": " << ate(odo_paired, truth_paired);
       if (!ref_paired.empty()) j << ",\n  \"reference_ate\": " << ate(ref_paired, ref_truth_paired);
@@ -443,12 +465,12 @@ class SlamStage : public Stage {
       << ",\n  \"timing\": {\"scan_update_ms\": " << SampleStats::Of(update_ms).Json()
       << ", \"filter_update_ms\": " << SampleStats::Of(filter_ms).Json() << ", \"wall_s\": " << Num(wall_s)
       << ", \"data_s\": " << Num(data_s) << ", \"real_time_factor\": " << Num(wall_s > 0 ? data_s / wall_s : NAN) << "}"
-      << ",\n  \"map\": {\"width\": " << map.width() << ", \"height\": " << map.height()
+      << ",\n  \"map\": {\"scan_consistency\": " << Num(consistency) << ", \"width\": " << map.width() << ", \"height\": " << map.height()
       << ", \"resolution\": " << Num(map.resolution()) << ", \"origin_x\": " << Num(map.origin_x())
       << ", \"origin_y\": " << Num(map.origin_y()) << "}\n}\n";
     WriteFileAtomically(dir + "metrics.json", [&](std::ostream& o) { o << j.str(); });
     mbot::log::Info("slam: " + std::to_string(records_.size()) + " scans (" + std::to_string(updates) +
-                    " filter updates), median " + Num(SampleStats::Of(update_ms).median, 3) + " ms per scan; outputs in " +
+                    " filter updates), scan consistency " + Num(consistency, 3) + ", median " + Num(SampleStats::Of(update_ms).median, 3) + " ms per scan; outputs in " +
                     ctx.output_dir);
   }
 
@@ -466,6 +488,9 @@ class SlamStage : public Stage {
   int64_t kidnap_us_ = -1, global_started_us_ = -1;
   int skipped_scans_ = 0;
   std::vector<ScanRecord> records_;
+  static constexpr size_t kMaxKeptScans = 200000;
+  mapping::SensorModel consistency_model_{mapping::SensorModelOptions{}};
+  std::vector<mapping::ScanPoints> scan_points_;  // per record, for the map-consistency metric
   std::vector<Pose2D> particle_snapshots_;
   double converged_at_s_ = -1;
   int converged_scan_ = -1;

@@ -149,7 +149,9 @@ FilterStatus ParticleFilter::Update(const ActionModel& action, const OdometrySte
   if (global_ && status_.spread_m < options_.converged_spread_m) global_ = false;
   status_.converged = !global_;
 
-  bad_scans_ = status_.inlier_fraction < options_.lost_inlier_fraction ? bad_scans_ + 1 : 0;
+  status_.fit_ratio = w_slow_ > 0 ? w_fast_ / w_slow_ : 1.0;
+  const bool bad = status_.inlier_fraction < options_.lost_inlier_fraction || status_.fit_ratio < options_.lost_fit_ratio;
+  bad_scans_ = bad ? bad_scans_ + 1 : 0;
   status_.lost = bad_scans_ >= options_.lost_scans;
   if (status_.lost && options_.relocalize_when_lost && !global_ && !free_cells_.empty()) {
     InitializeGlobal();

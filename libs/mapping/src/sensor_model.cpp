@@ -31,6 +31,11 @@ void SensorModel::SetMap(const OccupancyGrid& map) {
     };
     for (size_t i = 0; i < n; ++i) table_[i] = value(double(d2[i]) * res2);
     off_map_ = value(dmax2);
+    const int pw = width_ + 2;
+    padded_.assign(static_cast<size_t>(pw) * (height_ + 2), off_map_);
+    for (int y = 0; y < height_; ++y) {
+      std::copy_n(&table_[static_cast<size_t>(y) * width_], width_, &padded_[static_cast<size_t>(y + 1) * pw + 1]);
+    }
   } else {
     for (size_t i = 0; i < n; ++i) {
       const int odds = map.cells()[i];
@@ -71,11 +76,23 @@ double SensorModel::LogLikelihood(const motion::Pose2D& pose, const ScanPoints& 
   };
   double sum = 0.0;
   if (options_.kind == SensorModelKind::kLikelihoodField) {
+    // Branch-free: float cell coordinates shifted by the one-cell border, truncated and clamped into
+    // the padded table (anything off the map lands on the border's off-map value).
+    const float fc = static_cast<float>(c * inv_res), fs = static_cast<float>(s * inv_res);
+    const float fx = static_cast<float>(bx + 1.0), fy = static_cast<float>(by + 1.0);
+    const int max_x = width_ + 1, max_y = height_ + 1, pw = width_ + 2;
+    const float* xs = scan.x.data();
+    const float* ys = scan.y.data();
+    const float* table = padded_.data();
+    float acc = 0.0f;
     for (size_t i = 0; i < n; ++i) {
-      float v;
-      lookup(bx + (c * scan.x[i] - s * scan.y[i]) * inv_res, by + (s * scan.x[i] + c * scan.y[i]) * inv_res, &v);
-      sum += v;
+      const float gx = fx + fc * xs[i] - fs * ys[i];
+      const float gy = fy + fs * xs[i] + fc * ys[i];
+      const int cx = std::min(max_x, std::max(0, static_cast<int>(std::max(gx, -1.0f))));
+      const int cy = std::min(max_y, std::max(0, static_cast<int>(std::max(gy, -1.0f))));
+      acc += table[cy * pw + cx];
     }
+    sum = acc;
   } else {
     const double w = options_.neighbour_weight;
     for (size_t i = 0; i < n; ++i) {

@@ -23,8 +23,11 @@ Pose2D BestFitSE2(const std::vector<Pose2D>& est, const std::vector<Pose2D>& tru
     sxx += ax * bx + ay * by;
     sxy += ax * by - ay * bx;
   }
+  double spread = 0;  // RMS distance of the true positions from their centroid
+  for (size_t i = 0; i < n; ++i) spread += (truth[i].x - tx) * (truth[i].x - tx) + (truth[i].y - ty) * (truth[i].y - ty);
+  spread = std::sqrt(spread / n);
   double theta = std::atan2(sxy, sxx);
-  if (n == 1 || (sxx == 0 && sxy == 0)) {  // positions carry no rotation: use the mean heading offset
+  if (n == 1 || spread < 0.05) {  // positions (a robot standing still) fix no rotation: use the mean heading offset
     double s = 0, c = 0;
     for (size_t i = 0; i < n; ++i) {
       s += std::sin(truth[i].theta - est[i].theta);
@@ -57,7 +60,8 @@ AteResult ComputeAte(const std::vector<Pose2D>& est, const std::vector<Pose2D>& 
   if (est.empty() || est.size() != truth.size()) throw std::invalid_argument("ComputeAte: needs paired, non-empty series");
   AteResult r;
   r.samples = static_cast<int>(est.size());
-  r.alignment = alignment == AteAlignment::kBestFitSE2 ? BestFitSE2(est, truth) : truth.front().Compose(est.front().Inverse());
+  if (alignment == AteAlignment::kBestFitSE2) r.alignment = BestFitSE2(est, truth);
+  else if (alignment == AteAlignment::kFirstPose) r.alignment = truth.front().Compose(est.front().Inverse());
   std::vector<double> ex, ey, et, exy;
   for (size_t i = 0; i < est.size(); ++i) {
     const Pose2D a = r.alignment.Compose(est[i]);

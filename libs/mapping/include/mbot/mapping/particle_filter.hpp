@@ -34,8 +34,10 @@ struct ParticleFilterOptions {
   double alpha_slow = 0.02;
   double alpha_fast = 0.3;
   double max_injection = 0.05;    // at most this share of the particles is replaced per update
-  // Lost: the estimate's inlier share stays below this for `lost_scans` updates in a row.
+  // Lost: the estimate's inlier share stays below lost_inlier_fraction, or the short-term scan fit
+  // below lost_fit_ratio times the long-term one, for `lost_scans` updates in a row.
   double lost_inlier_fraction = 0.4;
+  double lost_fit_ratio = 0.7;
   int lost_scans = 3;
   bool relocalize_when_lost = false;
 };
@@ -46,6 +48,7 @@ struct FilterStatus {
   int particles = 0;
   int injected = 0;            // random particles injected by augmented MCL this update
   double inlier_fraction = 0;  // of the scan at the estimate
+  double fit_ratio = 1;        // short-term over long-term scan-fit average (augmented MCL's signal)
   double spread_m = 0;         // weighted standard deviation of the particle positions
   bool lost = false;
   bool relocalized = false;    // the filter was re-spread over the free space after this update

@@ -11,7 +11,7 @@
 
 namespace mbot::motion {
 
-enum class AteAlignment { kBestFitSE2, kFirstPose };
+enum class AteAlignment { kBestFitSE2, kFirstPose, kNone };  // kNone: the frames already agree
 
 struct ErrorStats {
   double rmse = 0, mean = 0, max = 0, std = 0;  // of the absolute error

@@ -1,0 +1,203 @@
+// The SLAM pieces on tiny fixtures: Bresenham ends, odds saturation, resampling, action-model
+// statistics, the sensor model's preference for the true pose, thread-count independence and ATE.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "mbot/mapping/action_model.hpp"
+#include "mbot/mapping/log_odds_mapper.hpp"
+#include "mbot/mapping/particle_filter.hpp"
+#include "mbot/mapping/sensor_model.hpp"
+#include "mbot/motion/trajectory_error.hpp"
+
+namespace mbot::mapping {
+namespace {
+
+using motion::Pose2D;
+
+TEST(Bresenham, IncludesBothEndsInOrder) {
+  std::vector<int> xs, ys;
+  BresenhamLine(0, 0, 5, -3, &xs, &ys);
+  ASSERT_GE(xs.size(), 6u);
+  EXPECT_EQ(xs.front(), 0);
+  EXPECT_EQ(ys.front(), 0);
+  EXPECT_EQ(xs.back(), 5);
+  EXPECT_EQ(ys.back(), -3);
+  for (size_t i = 1; i < xs.size(); ++i) {  // 8-connected steps
+    EXPECT_LE(std::abs(xs[i] - xs[i - 1]), 1);
+    EXPECT_LE(std::abs(ys[i] - ys[i - 1]), 1);
+  }
+}
+
+TEST(LogOddsMapper, HitsSaturateAt127AndMissesAtMinus127) {
+  MapperOptions o;
+  o.hit_odds = 50;
+  o.miss_odds = 40;
+  o.width_m = o.height_m = 2.0;
+  LogOddsMapper m(o);
+  const std::vector<ScanRay> rays = {ScanRay{0, 0, 0.52f, 0, true}};
+  for (int i = 0; i < 10; ++i) m.Insert(rays, Pose2D{});
+  int cx, cy;
+  m.map().WorldToCell(0.52, 0.0, &cx, &cy);
+  EXPECT_EQ(m.map().at(cx, cy), 127);
+  m.map().WorldToCell(0.26, 0.0, &cx, &cy);
+  EXPECT_EQ(m.map().at(cx, cy), -127);
+}
+
+TEST(LogOddsMapper, MissRaysClearButMarkNothingAndTheMapGrows) {
+  MapperOptions o;
+  o.width_m = o.height_m = 1.0;
+  LogOddsMapper m(o);
+  m.Insert({ScanRay{0, 0, 2.0f, 0, false}}, Pose2D{});
+  EXPECT_GE(m.grow_count(), 1);
+  EXPECT_EQ(m.map().CountCells().occupied, 0);
+  int cx, cy;
+  m.map().WorldToCell(1.9, 0.0, &cx, &cy);
+  ASSERT_TRUE(m.map().IsInside(cx, cy));
+  EXPECT_LT(m.map().at(cx, cy), 0);
+}
+
+TEST(ActionModel, SampleSpreadMatchesK1K2) {
+  ActionModelOptions o;
+  o.k1 = 0.01;
+  o.k2 = 0.02;
+  o.min_sigma_rot_rad = o.min_sigma_trans_m = 0;
+  ActionModel a(o);
+  const OdometryStep step = ActionModel::StepBetween(Pose2D{}, Pose2D{1.0, 0.0, 0.0});
+  EXPECT_NEAR(step.trans, 1.0, 1e-12);
+  double sum = 0, sq = 0;
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) {
+    const Pose2D p = a.Sample(Pose2D{}, step, 1000 + i);
+    sum += p.x;
+    sq += p.x * p.x;
+  }
+  const double mean = sum / n, sd = std::sqrt(sq / n - mean * mean);
+  EXPECT_NEAR(mean, 1.0, 0.005);
+  EXPECT_NEAR(sd, std::sqrt(0.02 * 1.0), 0.1 * std::sqrt(0.02));  // σ_trans = sqrt(k2·|trans|) within 10 %
+}
+
+TEST(ActionModel, BackwardStepKeepsSmallRotations) {
+  const OdometryStep s = ActionModel::StepBetween(Pose2D{}, Pose2D{-0.5, 0.0, 0.0});
+  EXPECT_NEAR(s.trans, -0.5, 1e-12);
+  EXPECT_NEAR(s.rot1, 0.0, 1e-12);
+  EXPECT_NEAR(s.rot2, 0.0, 1e-12);
+}
+
+// A 4 m square room at 5 cm with the robot at (1.0, 0.5, 0.3) and a full-turn scan from there.
+struct Room {
+  OccupancyGrid map{80, 80, 0.05, -2.0, -2.0, -100};
+  std::vector<ScanRay> rays;
+  Pose2D truth{1.0, 0.5, 0.3};
+  Room() {
+    for (int i = 0; i < 80; ++i) map.at(i, 0) = map.at(i, 79) = map.at(0, i) = map.at(79, i) = 100;
+    for (int k = 0; k < 180; ++k) {  // ray-march to the wall in the world, then express in the robot frame
+      const double a = truth.theta + k * 2 * M_PI / 180;
+      double r = 0;
+      int cx, cy;
+      do {
+        r += 0.005;
+        map.WorldToCell(truth.x + r * std::cos(a), truth.y + r * std::sin(a), &cx, &cy);
+      } while (map.at(cx, cy) <= 0);
+      const double la = a - truth.theta;
+      rays.push_back(ScanRay{0, 0, float(r * std::cos(la)), float(r * std::sin(la)), true});
+    }
+  }
+};
+
+TEST(SensorModel, LikelihoodFieldPrefersTheTruePose) {
+  Room room;
+  for (auto kind : {SensorModelKind::kLikelihoodField, SensorModelKind::kSimplifiedField}) {
+    SensorModelOptions o;
+    o.kind = kind;
+    SensorModel sm(o);
+    sm.SetMap(room.map);
+    const ScanPoints pts = sm.Prepare(room.rays);
+    const double best = sm.LogLikelihood(room.truth, pts);
+    for (const Pose2D& off : {Pose2D{0.1, 0, 0}, Pose2D{0, -0.1, 0}, Pose2D{0, 0, 0.1}}) {
+      const Pose2D wrong{room.truth.x + off.x, room.truth.y + off.y, room.truth.theta + off.theta};
+      EXPECT_GT(best, sm.LogLikelihood(wrong, pts)) << int(kind);
+    }
+    EXPECT_GT(sm.InlierFraction(room.truth, pts), 0.95);
+    EXPECT_LT(sm.InlierFraction(Pose2D{-1.0, -1.0, 2.0}, pts), 0.6);
+  }
+}
+
+TEST(ParticleFilter, SameResultForAnyThreadCountAndResamplingKeepsTheMean) {
+  Room room;
+  SensorModel sm(SensorModelOptions{});
+  sm.SetMap(room.map);
+  const ScanPoints pts = sm.Prepare(room.rays);
+  ActionModel am(ActionModelOptions{});
+  std::vector<std::vector<Particle>> results;
+  for (int threads : {1, 2}) {
+    ParticleFilterOptions o;
+    o.particles = 2000;
+    o.threads = threads;
+    ParticleFilter pf(o, 42);
+    pf.InitializeAt(Pose2D{0.95, 0.55, 0.25}, 0.05, 0.05);
+    for (int k = 0; k < 5; ++k) pf.Update(am, OdometryStep{}, sm, pts);
+    results.push_back(pf.particles());
+    EXPECT_NEAR(pf.status().pose.x, room.truth.x, 0.03);
+    EXPECT_NEAR(pf.status().pose.y, room.truth.y, 0.03);
+    EXPECT_NEAR(pf.status().pose.theta, room.truth.theta, 0.03);
+    EXPECT_GT(pf.status().ess, 1.0);
+  }
+  ASSERT_EQ(results[0].size(), results[1].size());
+  for (size_t i = 0; i < results[0].size(); ++i) {
+    EXPECT_EQ(results[0][i].pose.x, results[1][i].pose.x);
+    EXPECT_EQ(results[0][i].weight, results[1][i].weight);
+  }
+}
+
+TEST(ParticleFilter, GlobalLocalizationFindsTheRobotInTheRoom) {
+  Room room;
+  // Break the room's symmetry: wall off one quadrant, making it L-shaped.
+  for (int x = 40; x < 80; ++x)
+    for (int y = 0; y < 30; ++y) room.map.at(x, y) = 100;
+  std::vector<ScanRay> rays;
+  for (int k = 0; k < 180; ++k) {
+    const double a = room.truth.theta + k * 2 * M_PI / 180;
+    double r = 0;
+    int cx, cy;
+    do {
+      r += 0.005;
+      room.map.WorldToCell(room.truth.x + r * std::cos(a), room.truth.y + r * std::sin(a), &cx, &cy);
+    } while (room.map.at(cx, cy) <= 0);
+    rays.push_back(ScanRay{0, 0, float(r * std::cos(a - room.truth.theta)), float(r * std::sin(a - room.truth.theta)), true});
+  }
+  SensorModelOptions so;
+  so.log_scale = 0.2;
+  SensorModel sm(so);
+  sm.SetMap(room.map);
+  const ScanPoints pts = sm.Prepare(rays);
+  ActionModel am(ActionModelOptions{});
+  ParticleFilterOptions o;
+  o.global_particles = 50000;
+  ParticleFilter pf(o, 7);
+  pf.SetFreeSpace(room.map);
+  pf.InitializeGlobal();
+  for (int k = 0; k < 10; ++k) pf.Update(am, OdometryStep{}, sm, pts);
+  EXPECT_TRUE(pf.status().converged);
+  EXPECT_NEAR(pf.status().pose.x, room.truth.x, 0.1);
+  EXPECT_NEAR(pf.status().pose.y, room.truth.y, 0.1);
+}
+
+TEST(TrajectoryError, AlignmentRemovesAKnownRigidTransform) {
+  std::vector<Pose2D> truth, est;
+  const Pose2D t{0.3, -0.2, 0.4};
+  for (int i = 0; i < 50; ++i) {
+    const Pose2D p{std::cos(i * 0.1), std::sin(i * 0.2), i * 0.05};
+    truth.push_back(p);
+    est.push_back(t.Inverse().Compose(p));
+  }
+  const auto a = motion::ComputeAte(est, truth, motion::AteAlignment::kBestFitSE2);
+  EXPECT_LT(a.xy.rmse, 1e-9);
+  EXPECT_LT(a.theta.rmse, 1e-9);
+  EXPECT_NEAR(a.alignment.theta, 0.4, 1e-9);
+  const auto u = motion::ComputeAte(est, truth, motion::AteAlignment::kNone);
+  EXPECT_GT(u.xy.rmse, 0.1);
+}
+
+}  // namespace
+}  // namespace mbot::mapping
