@@ -130,6 +130,14 @@ TEST(SensorModel, LikelihoodFieldPrefersTheTruePose) {
   }
 }
 
+TEST(SensorModel, WithoutAMapEveryPoseWeighsTheSame) {  // action-only mode
+  Room room;
+  SensorModel sm(SensorModelOptions{});
+  const ScanPoints pts = sm.Prepare(room.rays);
+  EXPECT_EQ(sm.LogLikelihood(room.truth, pts), 0.0);
+  EXPECT_EQ(sm.LogLikelihood(Pose2D{-1, 2, 3}, pts), 0.0);
+}
+
 TEST(ParticleFilter, SameResultForAnyThreadCountAndResamplingKeepsTheMean) {
   Room room;
   SensorModel sm(SensorModelOptions{});

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <iomanip>
 #include <sstream>
 #include <string>
@@ -27,6 +28,13 @@ inline std::string JsonString(const std::string& s) {
     o += c;
   }
   return o + "\"";
+}
+
+// One TUM trajectory line, "t x y z qx qy qz qw", for a planar pose at t seconds.
+inline std::string TumLine(double t_s, double x, double y, double theta) {
+  char line[160];
+  std::snprintf(line, sizeof line, "%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", t_s, x, y, std::sin(theta / 2), std::cos(theta / 2));
+  return line;
 }
 
 // A number for JSON: non-finite values become null.

@@ -326,12 +326,7 @@ class SlamStage : public Stage {
   void WriteTum(const std::string& path, const std::string& what, const std::vector<TimedPose>& poses) const {
     WriteFileAtomically(path, [&](std::ostream& o) {
       o << "# " << what << ": t x y z qx qy qz qw\n";
-      char line[160];
-      for (const TimedPose& p : poses) {
-        std::snprintf(line, sizeof line, "%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", p.t_us * 1e-6, p.pose.x, p.pose.y,
-                      std::sin(p.pose.theta / 2), std::cos(p.pose.theta / 2));
-        o << line;
-      }
+      for (const TimedPose& p : poses) o << TumLine(p.t_us * 1e-6, p.pose.x, p.pose.y, p.pose.theta);
     });
   }
 

@@ -8,6 +8,7 @@
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
+#include "report.hpp"
 #include "stages.hpp"
 
 namespace mbot::app {
@@ -38,10 +39,7 @@ class TrajectoryWriterStage : public Stage {
                                                                " channel " + ev.channel + " ignored; writing " + track.channel);
       return;
     }
-    char line[160];
-    std::snprintf(line, sizeof line, "%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", ev.t_us * 1e-6, pose->x, pose->y,
-                  std::sin(pose->theta / 2), std::cos(pose->theta / 2));
-    track.text += line;
+    track.text += TumLine(ev.t_us * 1e-6, pose->x, pose->y, pose->theta);
   }
 
   void Finish(const RunContext& ctx, bool /*interrupted*/) override {

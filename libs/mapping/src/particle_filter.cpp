@@ -163,7 +163,8 @@ FilterStatus ParticleFilter::Update(const ActionModel& action, const OdometrySte
 void ParticleFilter::Estimate() {
   const size_t n = particles_.size();
   const size_t k = std::max<size_t>(1, static_cast<size_t>(std::ceil(options_.top_fraction * n)));
-  std::vector<uint32_t> order(n);
+  std::vector<uint32_t>& order = order_;  // kept between updates: no allocation per scan
+  order.resize(n);
   std::iota(order.begin(), order.end(), 0u);
   std::nth_element(order.begin(), order.begin() + (k - 1), order.end(), [&](uint32_t a, uint32_t b) {
     return particles_[a].weight > particles_[b].weight || (particles_[a].weight == particles_[b].weight && a < b);

@@ -21,7 +21,6 @@ void SensorModel::SetMap(const OccupancyGrid& map) {
   const double inlier2 = options_.inlier_distance_m * options_.inlier_distance_m / res2;
   inlier_.resize(n);
   for (size_t i = 0; i < n; ++i) inlier_[i] = d2[i] <= inlier2;
-  table_.resize(n);
   if (options_.kind == SensorModelKind::kLikelihoodField) {
     const double inv2s2 = 1.0 / (2.0 * options_.sigma_m * options_.sigma_m);
     const double dmax2 = options_.max_distance_m * options_.max_distance_m;
@@ -29,18 +28,22 @@ void SensorModel::SetMap(const OccupancyGrid& map) {
     auto value = [&](double dist2_m) {
       return static_cast<float>(std::log(std::exp(-std::min(dist2_m, dmax2) * inv2s2) + options_.random_weight) - norm);
     };
-    for (size_t i = 0; i < n; ++i) table_[i] = value(double(d2[i]) * res2);
     off_map_ = value(dmax2);
     const int pw = width_ + 2;
     padded_.assign(static_cast<size_t>(pw) * (height_ + 2), off_map_);
     for (int y = 0; y < height_; ++y) {
-      std::copy_n(&table_[static_cast<size_t>(y) * width_], width_, &padded_[static_cast<size_t>(y + 1) * pw + 1]);
+      float* row = &padded_[static_cast<size_t>(y + 1) * pw + 1];
+      const float* d2_row = &d2[static_cast<size_t>(y) * width_];
+      for (int x = 0; x < width_; ++x) row[x] = value(double(d2_row[x]) * res2);
     }
+    table_.clear();
   } else {
+    table_.resize(n);
     for (size_t i = 0; i < n; ++i) {
       const int odds = map.cells()[i];
       table_[i] = odds > options_.occupied_threshold ? static_cast<float>(odds * options_.odds_scale) : 0.0f;
     }
+    padded_.clear();
     off_map_ = 0.0f;
   }
 }
@@ -62,6 +65,7 @@ ScanPoints SensorModel::Prepare(const std::vector<ScanRay>& rays) const {
 }
 
 double SensorModel::LogLikelihood(const motion::Pose2D& pose, const ScanPoints& scan) const {
+  if (!has_map()) return 0.0;  // action-only: every pose weighs the same
   const double c = std::cos(pose.theta), s = std::sin(pose.theta);
   const double inv_res = 1.0 / resolution_;
   const double bx = (pose.x - origin_x_) * inv_res, by = (pose.y - origin_y_) * inv_res;

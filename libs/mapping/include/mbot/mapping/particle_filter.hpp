@@ -86,6 +86,7 @@ class ParticleFilter {
   std::vector<Particle> particles_;
   std::vector<Particle> scratch_;
   std::vector<double> log_w_;
+  std::vector<uint32_t> order_;  // Estimate's scratch
   FilterStatus status_;
   bool global_ = false;
   double w_slow_ = 0.0, w_fast_ = 0.0;

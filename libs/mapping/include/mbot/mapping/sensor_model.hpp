@@ -57,9 +57,9 @@ class SensorModel {
   SensorModelOptions options_;
   int width_ = 0, height_ = 0;
   double resolution_ = 0.05, origin_x_ = 0, origin_y_ = 0;
-  std::vector<float> table_;    // per-cell log-likelihood (field) or scaled log-odds (simplified)
-  // The likelihood field again with a one-cell border holding the off-map value, so the inner loop
-  // clamps its indices instead of branching: (width + 2) × (height + 2).
+  std::vector<float> table_;    // simplified field: per-cell scaled log-odds
+  // Likelihood field: per-cell log-likelihood with a one-cell border holding the off-map value, so
+  // the inner loop clamps its indices instead of branching: (width + 2) × (height + 2).
   std::vector<float> padded_;
   std::vector<uint8_t> inlier_; // per cell: within inlier_distance_m of an obstacle
   float off_map_ = 0.0f;        // value of a point off the map
