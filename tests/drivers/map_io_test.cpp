@@ -1,7 +1,12 @@
 #include "mbot/drivers/map_io.hpp"
 
 #include <gtest/gtest.h>
+#include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPose3DPDFGaussian.h>
 
+#include <cmath>
 #include <fstream>
 
 #include "test_util.hpp"
@@ -77,6 +82,49 @@ TEST(MapIoTest, MovingAiMapFlipsRowsAndHandlesCrlf) {
   EXPECT_GT(g.at(1, 1), 0);  // '@'
   EXPECT_GT(g.at(2, 1), 0);  // 'T'
   EXPECT_LT(g.at(2, 0), 0);  // 'S' passable
+}
+
+TEST(MapIoTest, SimplemapScansAreInsertedAtTheirKeyframePoses) {
+  // One keyframe at (1, 2) facing +y, with a 3-beam scan that hits a wall 1 m ahead.
+  mrpt::maps::CSimpleMap sm;
+  auto scan = std::make_shared<mrpt::obs::CObservation2DRangeScan>();
+  scan->aperture = static_cast<float>(0.2);
+  scan->maxRange = 10.0f;
+  scan->resizeScan(3);
+  for (size_t i = 0; i < 3; ++i) scan->setScanRange(i, 1.0f), scan->setScanRangeValidity(i, true);
+  auto sf = std::make_shared<mrpt::obs::CSensoryFrame>();
+  sf->insert(scan);
+  auto pose = std::make_shared<mrpt::poses::CPose3DPDFGaussian>(mrpt::poses::CPose3D(1.0, 2.0, 0.0, M_PI / 2, 0, 0));
+  sm.insert(pose, sf);
+  const auto path = test::TempPath("one.simplemap.gz");
+  ASSERT_TRUE(sm.saveToFile(path));
+  std::string format;
+  const auto g = ReadAnyMap(path, &format);
+  EXPECT_EQ(format, "MRPT simplemap (scans inserted at 0.05 m)");
+  int cx, cy;
+  g.WorldToCell(1.0, 3.0, &cx, &cy);
+  ASSERT_TRUE(g.IsInside(cx, cy));
+  EXPECT_GT(g.at(cx, cy), 0);  // the middle beam's end: the wall
+  g.WorldToCell(1.0, 2.5, &cx, &cy);
+  ASSERT_TRUE(g.IsInside(cx, cy));
+  EXPECT_LT(g.at(cx, cy), 0);  // cleared on the way
+  g.WorldToCell(2.0, 2.0, &cx, &cy);
+  ASSERT_TRUE(g.IsInside(cx, cy));
+  EXPECT_EQ(g.at(cx, cy), 0);  // never seen
+  EXPECT_TRUE(IsMapFile(path));
+}
+
+TEST(MapIoTest, SimplemapWithoutScansIsAnError) {
+  mrpt::maps::CSimpleMap sm;
+  sm.insert(std::make_shared<mrpt::poses::CPose3DPDFGaussian>(), std::make_shared<mrpt::obs::CSensoryFrame>());
+  const auto path = test::TempPath("empty.simplemap");
+  ASSERT_TRUE(sm.saveToFile(path));
+  try {
+    ReadMrptSimplemap(path);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path + ": holds no 2D range scans"), std::string::npos) << e.what();
+  }
 }
 
 TEST(MapIoTest, PngIsWritten) {

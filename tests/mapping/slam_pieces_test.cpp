@@ -188,6 +188,52 @@ TEST(ParticleFilter, GlobalLocalizationFindsTheRobotInTheRoom) {
   EXPECT_NEAR(pf.status().pose.y, room.truth.y, 0.1);
 }
 
+TEST(ParticleFilter, GlobalRegionLimitsTheFirstSpread) {
+  Room room;
+  ParticleFilterOptions o;
+  o.global_particles = 5000;
+  o.global_region = SearchBox{0.2, 0.8, 0.3, 0.6};
+  ParticleFilter pf(o, 3);
+  pf.SetFreeSpace(room.map);
+  pf.InitializeGlobal();
+  ASSERT_EQ(pf.particles().size(), 5000u);
+  for (const Particle& p : pf.particles()) {
+    ASSERT_GE(p.pose.x, 0.2 - room.map.resolution());
+    ASSERT_LE(p.pose.x, 0.8 + room.map.resolution());
+    ASSERT_GE(p.pose.y, 0.3 - room.map.resolution());
+    ASSERT_LE(p.pose.y, 0.6 + room.map.resolution());
+  }
+  o.global_region = SearchBox{50, 60, 50, 60};  // off the map
+  ParticleFilter off(o, 3);
+  off.SetFreeSpace(room.map);
+  EXPECT_THROW(off.InitializeGlobal(), std::runtime_error);
+}
+
+TEST(ParticleFilter, GlobalSearchTempersTheLikelihoodToKeepParticlesEffective) {
+  Room room;
+  const std::vector<ScanRay> rays = MarchScan(room.map, room.truth);
+  SensorModel sm(SensorModelOptions{});  // untempered: one scan is far too peaked for 20k spread particles
+  sm.SetMap(room.map);
+  const ScanPoints pts = sm.Prepare(rays);
+  ActionModel am(ActionModelOptions{});
+  for (double fraction : {0.0, 0.05}) {
+    ParticleFilterOptions o;
+    o.global_particles = 20000;
+    o.global_min_ess_fraction = fraction;
+    ParticleFilter pf(o, 11);
+    pf.SetFreeSpace(room.map);
+    pf.InitializeGlobal();
+    const FilterStatus s = pf.Update(am, OdometryStep{}, sm, pts);
+    if (fraction == 0.0) {
+      EXPECT_EQ(s.tempering, 1.0);
+      EXPECT_LT(s.ess, 0.05 * 20000);
+    } else {
+      EXPECT_LT(s.tempering, 1.0);
+      EXPECT_NEAR(s.ess, 0.05 * 20000, 0.05 * 20000 * 0.01);  // the largest exponent that keeps the target
+    }
+  }
+}
+
 TEST(TrajectoryError, AlignmentRemovesAKnownRigidTransform) {
   std::vector<Pose2D> truth, est;
   const Pose2D t{0.3, -0.2, 0.4};

@@ -7,23 +7,28 @@
 namespace mbot::app {
 namespace {
 
-motion::Pose2D ParsePose(config::Section& s, const std::string& key, const motion::Pose2D& def, const std::string& doc) {
-  const std::string d = std::to_string(def.x) + "," + std::to_string(def.y) + "," + std::to_string(def.theta);
-  const std::vector<std::string> v = s.GetList(key, {}, doc + " (x [m], y [m], theta [rad])");
-  if (v.empty()) return def;
-  if (v.size() != 3) s.Fail(key, "expected x, y, theta");
-  motion::Pose2D p;
-  double* out[3] = {&p.x, &p.y, &p.theta};
-  for (int i = 0; i < 3; ++i) {
+// `count` comma-separated finite numbers, or nothing (an empty vector) when the key is absent.
+std::vector<double> ParseNumbers(config::Section& s, const std::string& key, size_t count, const std::string& what,
+                                 const std::string& doc) {
+  const std::vector<std::string> v = s.GetList(key, {}, doc);
+  if (v.empty()) return {};
+  if (v.size() != count) s.Fail(key, "expected " + what);
+  std::vector<double> out(count);
+  for (size_t i = 0; i < count; ++i) {
     size_t used = 0;
     try {
-      *out[i] = std::stod(v[i], &used);
+      out[i] = std::stod(v[i], &used);
     } catch (...) {
       used = 0;
     }
-    if (used != v[i].size() || !std::isfinite(*out[i])) s.Fail(key, "'" + v[i] + "' is not a number");
+    if (used != v[i].size() || !std::isfinite(out[i])) s.Fail(key, "'" + v[i] + "' is not a number");
   }
-  return p;
+  return out;
+}
+
+motion::Pose2D ParsePose(config::Section& s, const std::string& key, const motion::Pose2D& def, const std::string& doc) {
+  const std::vector<double> v = ParseNumbers(s, key, 3, "x, y, theta", doc + " (x [m], y [m], theta [rad])");
+  return v.empty() ? def : motion::Pose2D{v[0], v[1], v[2]};
 }
 
 }  // namespace
@@ -128,6 +133,16 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
   f.threads = static_cast<int>(s.GetInt("threads", f.threads, "threads for the particles (0: all cores)", 0, 256));
   f.global_particles = static_cast<int>(s.GetInt("global_particles", f.global_particles, "particles for global localization", 1, 10'000'000));
   f.converged_spread_m = s.GetDouble("converged_spread_m", f.converged_spread_m, "a global search has converged below this spread", 0.0);
+  const std::vector<double> box = ParseNumbers(s, "global_region", 4, "min_x, max_x, min_y, max_y",
+      "global localization starts from the free cells inside this box (min_x, max_x, min_y, max_y [m]); empty: the whole map");
+  if (!box.empty()) {
+    if (!(box[0] < box[1] && box[2] < box[3])) s.Fail("global_region", "needs min_x < max_x and min_y < max_y");
+    f.global_region = mapping::SearchBox{box[0], box[1], box[2], box[3]};
+  }
+  f.global_min_ess_fraction = s.GetDouble("global_min_ess_fraction", f.global_min_ess_fraction,
+                                          "a global search tempers the scan likelihood to keep this share of particles effective (0: off)", 0.0, 1.0);
+  f.converged_inlier_fraction = s.GetDouble("converged_inlier_fraction", f.converged_inlier_fraction,
+                                            "a settled global search is accepted when this share of the scan fits the map, else it starts again", 0.0, 1.0);
   f.augmented = s.GetBool("augmented", m.mode == mapping::SlamMode::kLocalization, "augmented MCL: inject random particles when the fit drops");
   f.alpha_slow = s.GetDouble("alpha_slow", f.alpha_slow, "augmented MCL: long-term fit average rate", 0.0, 1.0);
   f.alpha_fast = s.GetDouble("alpha_fast", f.alpha_fast, "augmented MCL: short-term fit average rate", 0.0, 1.0);

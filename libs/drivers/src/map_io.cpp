@@ -3,6 +3,9 @@
 
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
+#include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/poses/CPose3DPDF.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include <algorithm>
@@ -19,6 +22,7 @@
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/strings.hpp"
+#include "mbot/mapping/log_odds_mapper.hpp"
 
 namespace fs = std::filesystem;
 
@@ -201,6 +205,50 @@ mapping::OccupancyGrid ReadMrptGridmap(const std::string& path) {
   return out;
 }
 
+mapping::OccupancyGrid ReadMrptSimplemap(const std::string& path, double resolution_m) {
+  if (!fs::is_regular_file(path)) Fail(path, "no such file");
+  mrpt::maps::CSimpleMap sm;
+  try {
+    if (!sm.loadFromFile(path)) Fail(path, "cannot read MRPT simplemap");
+  } catch (const std::runtime_error& e) {
+    if (std::string(e.what()).rfind(path, 0) == 0) throw;
+    Fail(path, std::string("cannot read MRPT simplemap: ") + e.what());
+  }
+  mapping::MapperOptions options;
+  options.resolution_m = resolution_m;
+  for (size_t k = 0; k < sm.size(); ++k) {  // start the extent around the first keyframe
+    if (const auto pair = sm.getAsPair(k); pair.pose) {
+      options.center_x_m = pair.pose->getMeanVal().x();
+      options.center_y_m = pair.pose->getMeanVal().y();
+      break;
+    }
+  }
+  mapping::LogOddsMapper mapper(options);
+  const mapping::ScanOptions scan_options;
+  size_t scans = 0;
+  for (size_t k = 0; k < sm.size(); ++k) {
+    const auto pair = sm.getAsPair(k);
+    if (!pair.pose || !pair.sf) continue;
+    const mrpt::poses::CPose3D mean = pair.pose->getMeanVal();
+    const motion::Pose2D robot{mean.x(), mean.y(), mean.yaw()};
+    for (const auto& obs : *pair.sf) {
+      auto scan = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(obs);
+      if (!scan) continue;
+      const size_t n = scan->getScanSize();
+      std::vector<float> ranges(n), angles(n), fractions(n, 1.0f);  // a keyframe's scan has one pose
+      for (size_t i = 0; i < n; ++i) {
+        ranges[i] = scan->getScanRangeValidity(i) ? scan->getScanRange(i) : 0.0f;
+        angles[i] = static_cast<float>(scan->getScanAngle(i));
+      }
+      const motion::Pose2D sensor{scan->sensorPose.x(), scan->sensorPose.y(), scan->sensorPose.yaw()};
+      mapper.Insert(mapping::DeskewScan(ranges, angles, fractions, {}, sensor, scan->maxRange, scan_options), robot);
+      ++scans;
+    }
+  }
+  if (scans == 0) Fail(path, "holds no 2D range scans to build a grid from (" + std::to_string(sm.size()) + " keyframes)");
+  return mapper.map();
+}
+
 mapping::OccupancyGrid ReadMovingAiMap(const std::string& path) {
   std::ifstream in(path);
   if (!in) Fail(path, "cannot open map");
@@ -307,7 +355,7 @@ void WriteOctomap(const mapping::OccupancyGrid& g, double wall_height_m, const s
 }
 
 bool IsMapFile(const std::string& path) {
-  for (const char* ext : {".yaml", ".yml", ".gridmap", ".gridmap.gz", ".map"}) {
+  for (const char* ext : {".yaml", ".yml", ".gridmap", ".gridmap.gz", ".simplemap", ".simplemap.gz", ".map"}) {
     if (EndsWith(path, ext)) return true;
   }
   return false;
@@ -325,6 +373,10 @@ mapping::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format) 
     set("MRPT gridmap");
     return ReadMrptGridmap(path);
   }
+  if (EndsWith(path, ".simplemap") || EndsWith(path, ".simplemap.gz")) {
+    set("MRPT simplemap (scans inserted at 0.05 m)");
+    return ReadMrptSimplemap(path);
+  }
   if (EndsWith(path, ".map")) {
     std::ifstream in(path);
     std::string first;
@@ -336,7 +388,7 @@ mapping::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format) 
     set("botlab .map");
     return ReadBotlabMap(path);
   }
-  Fail(path, "not a known map format (.map, .yaml, .gridmap, .gridmap.gz)");
+  Fail(path, "not a known map format (.map, .yaml, .gridmap, .gridmap.gz, .simplemap, .simplemap.gz)");
 }
 
 }  // namespace mbot::drivers

@@ -48,12 +48,20 @@ void ParticleFilter::SetFreeSpace(const OccupancyGrid& map) {
   free_resolution_ = map.resolution();
   free_origin_x_ = map.origin_x();
   free_origin_y_ = map.origin_y();
+  region_cells_.clear();
+  if (const auto& box = options_.global_region) {
+    for (int32_t cell : free_cells_) {
+      double x, y;
+      map.CellToWorld(cell % free_width_, cell / free_width_, &x, &y);
+      if (x >= box->min_x && x <= box->max_x && y >= box->min_y && y <= box->max_y) region_cells_.push_back(cell);
+    }
+  }
 }
 
-motion::Pose2D ParticleFilter::RandomFreePose(uint64_t key) const {
+motion::Pose2D ParticleFilter::RandomFreePose(const std::vector<int32_t>& cells, uint64_t key) const {
   CounterRng rng(key);
-  const size_t k = std::min(free_cells_.size() - 1, static_cast<size_t>(rng.Uniform() * free_cells_.size()));
-  const int cell = free_cells_[k];
+  const size_t k = std::min(cells.size() - 1, static_cast<size_t>(rng.Uniform() * cells.size()));
+  const int cell = cells[k];
   const int cx = cell % free_width_, cy = cell / free_width_;
   return {free_origin_x_ + (cx + rng.Uniform()) * free_resolution_,
           free_origin_y_ + (cy + rng.Uniform()) * free_resolution_, motion::WrapAngle((2.0 * rng.Uniform() - 1.0) * M_PI)};
@@ -61,10 +69,19 @@ motion::Pose2D ParticleFilter::RandomFreePose(uint64_t key) const {
 
 void ParticleFilter::InitializeGlobal() {
   if (free_cells_.empty()) throw std::runtime_error("global localization: the map has no free cells");
+  if (options_.global_region) {
+    if (region_cells_.empty()) throw std::runtime_error("global localization: no free cells inside global_region");
+    Spread(region_cells_);
+  } else {
+    Spread(free_cells_);
+  }
+}
+
+void ParticleFilter::Spread(const std::vector<int32_t>& cells) {
   const int n = std::max(options_.global_particles, options_.particles);
   particles_.resize(n);
   const uint64_t base = StreamKey(seed_, kTagGlobal, static_cast<uint64_t>(updates_));
-  for (int i = 0; i < n; ++i) particles_[i] = Particle{RandomFreePose(StreamKey(base, 0, i)), 1.0 / n};
+  for (int i = 0; i < n; ++i) particles_[i] = Particle{RandomFreePose(cells, StreamKey(base, 0, i)), 1.0 / n};
   global_ = true;
   bad_scans_ = 0;
   w_slow_ = w_fast_ = 0.0;
@@ -104,7 +121,7 @@ FilterStatus ParticleFilter::Update(const ActionModel& action, const OdometrySte
     for (int k = 0; k < injected; ++k) {
       // Spread the replaced slots over the set so no one region of the resampled set is favoured.
       const size_t slot = static_cast<size_t>((k + 0.5) * count / injected);
-      particles_[std::min(slot, particles_.size() - 1)].pose = RandomFreePose(StreamKey(base, 0, k));
+      particles_[std::min(slot, particles_.size() - 1)].pose = RandomFreePose(free_cells_, StreamKey(base, 0, k));
     }
   }
 
@@ -122,12 +139,37 @@ FilterStatus ParticleFilter::Update(const ActionModel& action, const OdometrySte
   const double max_log = *std::max_element(log_w_.begin(), log_w_.end());
   double sum = 0.0, fit = 0.0;
   const double per_beam = scan.size() > 0 ? 1.0 / (scan.size() * std::max(1e-12, sensor.options().log_scale)) : 0.0;
-  for (int i = 0; i < n; ++i) {
-    particles_[i].weight = std::exp(log_w_[i] - max_log);
-    sum += particles_[i].weight;
-    fit += std::exp(log_w_[i] * per_beam);
-  }
+  for (int i = 0; i < n; ++i) fit += std::exp(log_w_[i] * per_beam);
   fit /= n;
+  // During a global search one scan's likelihood is so peaked that a single resampling would keep
+  // only the best particle drawn, right or aliased. Temper it (weights ∝ L^β, β ≤ 1) so at least
+  // global_min_ess_fraction of the particles stay effective: evidence then accumulates over scans.
+  double beta = 1.0;
+  if (global_ && options_.global_min_ess_fraction > 0.0) {
+    const double target = options_.global_min_ess_fraction * n;
+    auto ess_at = [&](double b) {
+      double s1 = 0.0, s2 = 0.0;
+      for (int i = 0; i < n; ++i) {
+        const double w = std::exp(b * (log_w_[i] - max_log));
+        s1 += w;
+        s2 += w * w;
+      }
+      return s1 * s1 / s2;
+    };
+    if (ess_at(1.0) < target) {
+      double lo = 0.0, hi = 1.0;  // ESS falls as β grows: keep the largest β that meets the target
+      for (int it = 0; it < 30; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (ess_at(mid) >= target ? lo : hi) = mid;
+      }
+      beta = lo;
+    }
+  }
+  status_.tempering = beta;
+  for (int i = 0; i < n; ++i) {
+    particles_[i].weight = std::exp(beta * (log_w_[i] - max_log));
+    sum += particles_[i].weight;
+  }
   double sum_sq = 0.0;
   for (Particle& p : particles_) {
     p.weight /= sum;
@@ -146,15 +188,25 @@ FilterStatus ParticleFilter::Update(const ActionModel& action, const OdometrySte
   status_.injected = injected;
   status_.inlier_fraction = sensor.has_map() ? sensor.InlierFraction(status_.pose, scan) : 1.0;
   status_.relocalized = false;
-  if (global_ && status_.spread_m < options_.converged_spread_m) global_ = false;
+  bool respread = false;
+  if (global_ && status_.spread_m < options_.converged_spread_m) {
+    // Settled; but on a place that does not explain the scan (an aliased corridor, the right pose
+    // never drawn) the search starts again with fresh particles instead of tracking the wrong place.
+    if (status_.inlier_fraction >= options_.converged_inlier_fraction) {
+      global_ = false;
+      w_slow_ = w_fast_ = fit;  // the averages so far scored random particles: restart them
+    } else {
+      respread = true;
+    }
+  }
   status_.converged = !global_;
 
   status_.fit_ratio = w_slow_ > 0 ? w_fast_ / w_slow_ : 1.0;
   const bool bad = status_.inlier_fraction < options_.lost_inlier_fraction || status_.fit_ratio < options_.lost_fit_ratio;
   bad_scans_ = bad ? bad_scans_ + 1 : 0;
   status_.lost = bad_scans_ >= options_.lost_scans;
-  if (status_.lost && options_.relocalize_when_lost && !global_ && !free_cells_.empty()) {
-    InitializeGlobal();
+  if ((respread || (status_.lost && options_.relocalize_when_lost && !global_)) && !free_cells_.empty()) {
+    Spread(respread && options_.global_region ? region_cells_ : free_cells_);
     status_.relocalized = true;
   }
   return status_;

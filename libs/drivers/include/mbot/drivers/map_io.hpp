@@ -1,5 +1,5 @@
 // Occupancy-grid file formats: botlab `.map`, ROS map_server PGM + YAML, MRPT `.gridmap(.gz)`,
-// Moving AI `.map`, and PNG pictures. Readers throw std::runtime_error naming the file (and line).
+// MRPT `.simplemap(.gz)` (rendered to a grid), Moving AI `.map`, and PNG pictures. Readers throw std::runtime_error naming the file (and line).
 #pragma once
 
 #include <cstdint>
@@ -28,6 +28,11 @@ void WriteRosMap(const mapping::OccupancyGrid& grid, const std::string& yaml_pat
 // the probability of being free; it becomes log-odds of occupancy scaled by 20 and clamped.
 mapping::OccupancyGrid ReadMrptGridmap(const std::string& path);
 
+// MRPT CSimpleMap (keyframe poses, each with its sensory frame): every 2D range scan is inserted
+// at its keyframe's mean pose with the project's own log-odds mapper (default MapperOptions at
+// `resolution_m`, growing to fit), so the grid has the same log-odds semantics as one we map.
+mapping::OccupancyGrid ReadMrptSimplemap(const std::string& path, double resolution_m = 0.05);
+
 // Moving AI benchmark map ("type octile", height, width, "map", rows; (0,0) top-left). Passable
 // terrain ('.', 'G', 'S') becomes free (-127), everything else occupied (127); 1 m cells, with
 // Moving AI row r stored as grid row height-1-r.
@@ -55,7 +60,7 @@ void WriteOctomap(const mapping::OccupancyGrid& grid, double wall_height_m, cons
 // True when `path` has the extension of a map format ReadAnyMap reads.
 bool IsMapFile(const std::string& path);
 
-// Reads any of the formats above, chosen by extension and content.
+// Reads any of the formats above, chosen by extension and content (simplemaps at 0.05 m).
 mapping::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format = nullptr);
 
 }  // namespace mbot::drivers

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "mbot/mapping/action_model.hpp"
@@ -22,13 +23,26 @@ struct Particle {
   double weight = 0.0;  // normalised
 };
 
+struct SearchBox {
+  double min_x = 0, max_x = 0, min_y = 0, max_y = 0;
+};
+
 struct ParticleFilterOptions {
   int particles = 1000;
   double top_fraction = 0.15;     // the estimate is the weighted mean of this share of the best particles
   int threads = 0;                // 0: all cores
   // Global localization (and relocalization when lost).
   int global_particles = 20000;
+  // When set, the initial global search draws only from the free cells inside this box (what the
+  // operator knows about the start); relocalization after getting lost always uses all free space.
+  std::optional<SearchBox> global_region;
   double converged_spread_m = 0.15;  // a global search has converged when the particles' spread is below this
+  // While searching globally the scan likelihood is tempered so the effective sample size stays at
+  // least this share of the particles (0: never temper).
+  double global_min_ess_fraction = 0.05;
+  // A settled global search is accepted only when this share of the scan fits the map at the
+  // estimate; otherwise the particles are spread again.
+  double converged_inlier_fraction = 0.75;
   // Augmented MCL.
   bool augmented = false;
   double alpha_slow = 0.02;
@@ -53,6 +67,7 @@ struct FilterStatus {
   bool lost = false;
   bool relocalized = false;    // the filter was re-spread over the free space after this update
   bool converged = true;       // false while a global search has not settled
+  double tempering = 1.0;      // exponent applied to the scan likelihood this update (< 1 while searching)
 };
 
 class ParticleFilter {
@@ -64,7 +79,8 @@ class ParticleFilter {
   // Where random particles may go: the map's free cells (log-odds < 0). Needed for global
   // localization and augmented MCL.
   void SetFreeSpace(const OccupancyGrid& map);
-  // global_particles particles uniform over the free space, uniform heading.
+  // global_particles particles uniform over the free space (inside global_region when set),
+  // uniform heading.
   void InitializeGlobal();
 
   // One filter step after the robot moved by `step`: resample, move, weigh, estimate.
@@ -76,7 +92,8 @@ class ParticleFilter {
   int64_t updates() const { return updates_; }
 
  private:
-  motion::Pose2D RandomFreePose(uint64_t key) const;
+  void Spread(const std::vector<int32_t>& cells);
+  motion::Pose2D RandomFreePose(const std::vector<int32_t>& cells, uint64_t key) const;
   void Resample(int count);
   void Estimate();
 
@@ -93,6 +110,7 @@ class ParticleFilter {
   int bad_scans_ = 0;
   // Free space for random particles.
   std::vector<int32_t> free_cells_;
+  std::vector<int32_t> region_cells_;  // free cells inside global_region
   int free_width_ = 0;
   double free_resolution_ = 0.05, free_origin_x_ = 0, free_origin_y_ = 0;
 };
