@@ -130,6 +130,35 @@ TEST(SensorModel, LikelihoodFieldPrefersTheTruePose) {
   }
 }
 
+TEST(SensorModel, UpdatingAMapGivesTheSameTablesAsBuildingItAfresh) {
+  for (auto kind : {SensorModelKind::kLikelihoodField, SensorModelKind::kSimplifiedField}) {
+    Room room;
+    SensorModelOptions o;
+    o.kind = kind;
+    SensorModel updated(o);
+    updated.SetMap(room.map);
+    updated.SetMap(room.map);  // nothing changed
+    // An obstacle appears inside, one wall cell vanishes, a free cell gets less free.
+    room.map.at(40, 40) = 90;
+    room.map.at(0, 10) = -20;
+    room.map.at(60, 20) = -5;
+    updated.SetMap(room.map);
+    SensorModel fresh(o);
+    fresh.SetMap(room.map);
+    ScanPoints one;
+    one.x = {0}, one.y = {0}, one.step_x = {0.05f}, one.step_y = {0};
+    for (int cy = -1; cy <= 80; ++cy) {
+      for (int cx = -1; cx <= 80; ++cx) {
+        double x, y;
+        room.map.CellToWorld(cx, cy, &x, &y);
+        const Pose2D at{x, y, 0};
+        ASSERT_EQ(updated.LogLikelihood(at, one), fresh.LogLikelihood(at, one)) << cx << "," << cy << " kind " << int(kind);
+        ASSERT_EQ(updated.InlierFraction(at, one), fresh.InlierFraction(at, one)) << cx << "," << cy;
+      }
+    }
+  }
+}
+
 TEST(SensorModel, WithoutAMapEveryPoseWeighsTheSame) {  // action-only mode
   Room room;
   SensorModel sm(SensorModelOptions{});

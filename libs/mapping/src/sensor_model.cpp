@@ -8,36 +8,15 @@
 namespace mbot::mapping {
 
 void SensorModel::SetMap(const OccupancyGrid& map) {
+  const bool same_geometry = width_ == map.width() && height_ == map.height() && resolution_ == map.resolution() &&
+                             origin_x_ == map.origin_x() && origin_y_ == map.origin_y();
   width_ = map.width();
   height_ = map.height();
   resolution_ = map.resolution();
   origin_x_ = map.origin_x();
   origin_y_ = map.origin_y();
   const size_t n = static_cast<size_t>(width_) * height_;
-  std::vector<uint8_t> obstacle(n);
-  for (size_t i = 0; i < n; ++i) obstacle[i] = map.cells()[i] > options_.occupied_threshold;
-  const std::vector<float> d2 = SquaredDistanceTransform(obstacle, width_, height_);
-  const double res2 = resolution_ * resolution_;
-  const double inlier2 = options_.inlier_distance_m * options_.inlier_distance_m / res2;
-  inlier_.resize(n);
-  for (size_t i = 0; i < n; ++i) inlier_[i] = d2[i] <= inlier2;
-  if (options_.kind == SensorModelKind::kLikelihoodField) {
-    const double inv2s2 = 1.0 / (2.0 * options_.sigma_m * options_.sigma_m);
-    const double dmax2 = options_.max_distance_m * options_.max_distance_m;
-    const double norm = std::log(1.0 + options_.random_weight);
-    auto value = [&](double dist2_m) {
-      return static_cast<float>(std::log(std::exp(-std::min(dist2_m, dmax2) * inv2s2) + options_.random_weight) - norm);
-    };
-    off_map_ = value(dmax2);
-    const int pw = width_ + 2;
-    padded_.assign(static_cast<size_t>(pw) * (height_ + 2), off_map_);
-    for (int y = 0; y < height_; ++y) {
-      float* row = &padded_[static_cast<size_t>(y + 1) * pw + 1];
-      const float* d2_row = &d2[static_cast<size_t>(y) * width_];
-      for (int x = 0; x < width_; ++x) row[x] = value(double(d2_row[x]) * res2);
-    }
-    table_.clear();
-  } else {
+  if (options_.kind == SensorModelKind::kSimplifiedField) {
     table_.resize(n);
     for (size_t i = 0; i < n; ++i) {
       const int odds = map.cells()[i];
@@ -45,6 +24,86 @@ void SensorModel::SetMap(const OccupancyGrid& map) {
     }
     padded_.clear();
     off_map_ = 0.0f;
+  }
+  // The distance tables depend only on which cells are obstacles. With the same geometry, only
+  // the cells near an obstacle that appeared or vanished can change, and only if one did.
+  std::vector<uint8_t> obstacle(n);
+  for (size_t i = 0; i < n; ++i) obstacle[i] = map.cells()[i] > options_.occupied_threshold;
+  if (!same_geometry || obstacle_.size() != n) {
+    obstacle_ = std::move(obstacle);
+    BuildLookup();
+    if (options_.kind == SensorModelKind::kLikelihoodField) {
+      padded_.assign(static_cast<size_t>(width_ + 2) * (height_ + 2), off_map_);
+      table_.clear();
+    }
+    inlier_.assign(n, 0);
+    UpdateDistances(0, 0, width_ - 1, height_ - 1);
+    return;
+  }
+  int x0 = width_, y0 = height_, x1 = -1, y1 = -1;
+  for (int y = 0; y < height_; ++y) {
+    const size_t row = static_cast<size_t>(y) * width_;
+    for (int x = 0; x < width_; ++x) {
+      if (obstacle[row + x] != obstacle_[row + x]) {
+        x0 = std::min(x0, x), x1 = std::max(x1, x);
+        y0 = std::min(y0, y), y1 = std::max(y1, y);
+      }
+    }
+  }
+  obstacle_ = std::move(obstacle);
+  if (x1 < 0) return;  // no obstacle changed
+  UpdateDistances(x0 - reach_cells_, y0 - reach_cells_, x1 + reach_cells_, y1 + reach_cells_);
+}
+
+void SensorModel::BuildLookup() {
+  // Exact squared distances between cells are integers; every one beyond the reach of the
+  // likelihood field and the inlier test scores as far away.
+  const double res2 = resolution_ * resolution_;
+  const double reach_m = std::max(options_.max_distance_m, options_.inlier_distance_m);
+  reach_cells_ = static_cast<int>(std::ceil(reach_m / resolution_)) + 1;
+  const double inv2s2 = 1.0 / (2.0 * options_.sigma_m * options_.sigma_m);
+  const double dmax2 = options_.max_distance_m * options_.max_distance_m;
+  const double norm = std::log(1.0 + options_.random_weight);
+  auto value = [&](double dist2_m) {
+    return static_cast<float>(std::log(std::exp(-std::min(dist2_m, dmax2) * inv2s2) + options_.random_weight) - norm);
+  };
+  off_map_ = options_.kind == SensorModelKind::kLikelihoodField ? value(dmax2) : 0.0f;
+  const int max_d2 = reach_cells_ * reach_cells_;
+  field_lut_.resize(max_d2 + 1);
+  inlier_lut_.resize(max_d2 + 1);
+  const double inlier2 = options_.inlier_distance_m * options_.inlier_distance_m;
+  for (int d2 = 0; d2 <= max_d2; ++d2) {
+    field_lut_[d2] = value(d2 * res2);
+    inlier_lut_[d2] = d2 * res2 <= inlier2 + 1e-12;
+  }
+}
+
+void SensorModel::UpdateDistances(int x0, int y0, int x1, int y1) {
+  // Cells of [x0, x1] × [y0, y1] get their distance to the nearest obstacle within reach; those
+  // obstacles lie inside the box grown by the reach, so the transform runs on that window only.
+  x0 = std::max(0, x0), y0 = std::max(0, y0);
+  x1 = std::min(width_ - 1, x1), y1 = std::min(height_ - 1, y1);
+  const int wx0 = std::max(0, x0 - reach_cells_), wy0 = std::max(0, y0 - reach_cells_);
+  const int wx1 = std::min(width_ - 1, x1 + reach_cells_), wy1 = std::min(height_ - 1, y1 + reach_cells_);
+  const int ww = wx1 - wx0 + 1, wh = wy1 - wy0 + 1;
+  std::vector<uint8_t> window(static_cast<size_t>(ww) * wh);
+  for (int y = 0; y < wh; ++y) {
+    std::copy_n(&obstacle_[static_cast<size_t>(wy0 + y) * width_ + wx0], ww, &window[static_cast<size_t>(y) * ww]);
+  }
+  const std::vector<float> d2 = SquaredDistanceTransform(window, ww, wh);
+  const int max_d2 = static_cast<int>(field_lut_.size()) - 1;
+  const bool field = options_.kind == SensorModelKind::kLikelihoodField;
+  const int pw = width_ + 2;
+  for (int y = y0; y <= y1; ++y) {
+    const float* d2_row = &d2[static_cast<size_t>(y - wy0) * ww];  // window column x - wx0
+    float* padded_row = field ? &padded_[static_cast<size_t>(y + 1) * pw + 1] : nullptr;
+    uint8_t* inlier_row = &inlier_[static_cast<size_t>(y) * width_];
+    for (int x = x0; x <= x1; ++x) {
+      const float w = d2_row[x - wx0];
+      const int k = w <= max_d2 ? static_cast<int>(w) : max_d2;
+      if (field) padded_row[x] = field_lut_[k];
+      inlier_row[x] = inlier_lut_[k];
+    }
   }
 }
 

@@ -44,7 +44,8 @@ struct ScanPoints {
 class SensorModel {
  public:
   explicit SensorModel(const SensorModelOptions& options) : options_(options) {}
-  // Builds the lookup tables for `map`; call again whenever the map changes.
+  // Builds the lookup tables for `map`; call again whenever the map changes. A map of the same
+  // geometry as the last one only recomputes the distances near obstacles that appeared or vanished.
   void SetMap(const OccupancyGrid& map);
   bool has_map() const { return width_ > 0; }
   ScanPoints Prepare(const std::vector<ScanRay>& rays) const;
@@ -54,6 +55,9 @@ class SensorModel {
   const SensorModelOptions& options() const { return options_; }
 
  private:
+  void BuildLookup();
+  void UpdateDistances(int x0, int y0, int x1, int y1);
+
   SensorModelOptions options_;
   int width_ = 0, height_ = 0;
   double resolution_ = 0.05, origin_x_ = 0, origin_y_ = 0;
@@ -63,6 +67,10 @@ class SensorModel {
   std::vector<float> padded_;
   std::vector<uint8_t> inlier_; // per cell: within inlier_distance_m of an obstacle
   float off_map_ = 0.0f;        // value of a point off the map
+  std::vector<uint8_t> obstacle_;  // the obstacle mask the distance tables were built from
+  int reach_cells_ = 0;            // distances beyond this many cells all score as "far"
+  std::vector<float> field_lut_;   // likelihood-field value by squared distance in cells²
+  std::vector<uint8_t> inlier_lut_;
 };
 
 }  // namespace mbot::mapping
