@@ -22,6 +22,7 @@
 #include "mbot/common/config.hpp"
 #include "mbot/motion/pose2d.hpp"
 #include "pipeline.hpp"
+#include "run_config.hpp"
 
 namespace mbot::app {
 namespace {
@@ -31,35 +32,8 @@ namespace fs = std::filesystem;
 std::string Data(const std::string& rel) { return config::DatasetsDir() + "/" + rel; }
 const std::string kLegacy = "botlab/legacy_2017/";
 
-// Runs a shipped config with overrides into a fresh folder; returns metrics.json's text.
 std::string RunSlam(const std::string& config_name, const std::string& out_name, const std::vector<std::string>& sets) {
-  auto c = config::Config::Load(std::string(MBOT_SOURCE_DIR) + "/config/" + config_name);
-  const std::string out = ::testing::TempDir() + "/slam_" + out_name;
-  fs::remove_all(out);
-  c.Set("output.dir=" + out);
-  c.Set("pipeline.progress=off");
-  for (const auto& s : sets) c.Set(s);
-  auto plan = BuildPlan(c);
-  std::atomic<bool> stop{false};
-  RunPlan(plan, stop);
-  std::ifstream in(out + "/metrics.json");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// The number after the keys, found one after another in the JSON text (e.g. "slam_ate",
-// "aligned", "x_m", "rmse").
-double Get(const std::string& json, const std::vector<std::string>& keys) {
-  size_t pos = 0;
-  for (const auto& k : keys) {
-    pos = json.find("\"" + k + "\"", pos);
-    if (pos == std::string::npos) ADD_FAILURE() << "no key " << k;
-    if (pos == std::string::npos) return NAN;
-    pos += k.size() + 2;
-  }
-  pos = json.find(':', pos);
-  return std::stod(json.substr(pos + 1));
+  return RunConfig(config_name, "slam_" + out_name, sets, "metrics.json");
 }
 
 double Rmse(const std::string& j, const char* who, const char* how, const char* axis) {

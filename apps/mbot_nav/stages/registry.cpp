@@ -8,7 +8,7 @@ const std::vector<StageType>& StageTypes() {
   static const std::vector<StageType> types = [] {
     std::vector<StageType> t = {InspectStageType(), TrajectoryWriterStageType(), MapWriterStageType(),
                                    AStarTestStageType(), MovingAiBenchmarkStageType(), ExplorationStageType(),
-                                   SlamStageType()};
+                                   SlamStageType(), OdometryStageType()};
     std::sort(t.begin(), t.end(), [](const StageType& a, const StageType& b) { return a.name < b.name; });
     return t;
   }();

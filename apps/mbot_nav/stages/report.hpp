@@ -9,6 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "mbot/motion/pose2d.hpp"
+#include "mbot/motion/trajectory_error.hpp"
+
 namespace mbot::app {
 
 inline double Median(std::vector<double> v) {
@@ -70,5 +73,23 @@ struct SampleStats {
            ", \"median\": " + Num(median) + ", \"max\": " + Num(max) + ", \"std\": " + Num(std) + "}";
   }
 };
+
+// Trajectory-error JSON, the layout metrics.json files share: per axis RMSE / mean / max / std,
+// heading in degrees, the final-pose error and the alignment applied.
+inline std::string PoseJson(const motion::Pose2D& p) {
+  return "{\"x\": " + Num(p.x) + ", \"y\": " + Num(p.y) + ", \"theta\": " + Num(p.theta) + "}";
+}
+
+inline std::string StatsJson(const motion::ErrorStats& s, double scale = 1.0) {
+  return "{\"rmse\": " + Num(s.rmse * scale) + ", \"mean\": " + Num(s.mean * scale) + ", \"max\": " + Num(s.max * scale) +
+         ", \"std\": " + Num(s.std * scale) + "}";
+}
+
+inline std::string AteJson(const motion::AteResult& a) {
+  return "{\"samples\": " + std::to_string(a.samples) + ", \"x_m\": " + StatsJson(a.x) + ", \"y_m\": " + StatsJson(a.y) +
+         ", \"xy_m\": " + StatsJson(a.xy) + ", \"theta_deg\": " + StatsJson(a.theta, 180.0 / M_PI) +
+         ", \"final_error\": {\"x_m\": " + Num(a.final_error.x) + ", \"y_m\": " + Num(a.final_error.y) +
+         ", \"theta_deg\": " + Num(a.final_error.theta * 180.0 / M_PI) + "}, \"alignment\": " + PoseJson(a.alignment) + "}";
+}
 
 }  // namespace mbot::app

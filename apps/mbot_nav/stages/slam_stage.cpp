@@ -30,22 +30,6 @@ using drivers::EventKind;
 using motion::Pose2D;
 using motion::TimedPose;
 
-std::string PoseJson(const Pose2D& p) {
-  return "{\"x\": " + Num(p.x) + ", \"y\": " + Num(p.y) + ", \"theta\": " + Num(p.theta) + "}";
-}
-
-std::string StatsJson(const motion::ErrorStats& s, double scale = 1.0) {
-  return "{\"rmse\": " + Num(s.rmse * scale) + ", \"mean\": " + Num(s.mean * scale) + ", \"max\": " + Num(s.max * scale) +
-         ", \"std\": " + Num(s.std * scale) + "}";
-}
-
-std::string AteJson(const motion::AteResult& a) {
-  return "{\"samples\": " + std::to_string(a.samples) + ", \"x_m\": " + StatsJson(a.x) + ", \"y_m\": " + StatsJson(a.y) +
-         ", \"xy_m\": " + StatsJson(a.xy) + ", \"theta_deg\": " + StatsJson(a.theta, 180.0 / M_PI) +
-         ", \"final_error\": {\"x_m\": " + Num(a.final_error.x) + ", \"y_m\": " + Num(a.final_error.y) +
-         ", \"theta_deg\": " + Num(a.final_error.theta * 180.0 / M_PI) + "}, \"alignment\": " + PoseJson(a.alignment) + "}";
-}
-
 // One processed scan.
 struct ScanRecord {
   int64_t t_us = 0;

@@ -12,5 +12,6 @@ StageType AStarTestStageType();
 StageType MovingAiBenchmarkStageType();
 StageType ExplorationStageType();
 StageType SlamStageType();
+StageType OdometryStageType();
 
 }  // namespace mbot::app

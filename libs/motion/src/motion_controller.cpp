@@ -1,0 +1,192 @@
+#include "mbot/motion/motion_controller.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+namespace mbot::motion {
+namespace {
+
+double Clamp(double x, double limit) { return std::clamp(x, -limit, limit); }
+
+double Dist(const Pose2D& a, const Pose2D& b) { return std::hypot(b.x - a.x, b.y - a.y); }
+
+// Direction of the point (x, y) seen from `p`, relative to its heading.
+double Bearing(const Pose2D& p, double x, double y) {
+  return WrapAngle(std::atan2(y - p.y, x - p.x) - p.theta);
+}
+
+}  // namespace
+
+MotionController::MotionController(const MotionControllerOptions& options) : options_(options) {
+  progress_.arrived = true;  // nothing to do until SetPath
+}
+
+void MotionController::SetPath(const std::vector<Pose2D>& waypoints) {
+  waypoints_ = waypoints;
+  phase_ = waypoints_.empty() ? Phase::kSettle : Phase::kFollow;
+  target_ = 0;
+  path_.clear();
+  arc_.clear();
+  segment_ = 0;
+  projection_m_ = 0.0;
+  progress_ = ControllerProgress{0, waypoints_.size(), 0.0, false};
+}
+
+VelocityCommand MotionController::Update(const Pose2D& pose, double dt_s) {
+  if (!waypoints_.empty()) progress_.distance_to_goal_m = Dist(pose, waypoints_.back());
+  if (progress_.arrived || dt_s <= 0.0) return last_;  // last_ is zero once arrived
+  const VelocityCommand target = Target(pose);
+  const double dv = options_.max_accel_m_s2 * dt_s;
+  const double dw = options_.max_angular_accel_rad_s2 * dt_s;
+  // Prefer the largest λ ∈ [0, 1] for which λ·target is reachable from the last command: it keeps
+  // the curvature ω/v the steering law asked for, so the robot drives the intended arc while it
+  // speeds up (clamping v and ω separately would turn far too sharply when starting from rest).
+  double lo = 0.0, hi = 1.0;
+  for (const auto& [t, c, d] :
+       {std::tuple{target.v_m_s, last_.v_m_s, dv}, std::tuple{target.w_rad_s, last_.w_rad_s, dw}}) {
+    if (t == 0.0) {
+      if (std::abs(c) > d) lo = INFINITY;
+      continue;
+    }
+    const double a = (c - d) / t, b = (c + d) / t;
+    lo = std::max(lo, std::min(a, b));
+    hi = std::min(hi, std::max(a, b));
+  }
+  if (lo <= hi) {
+    last_ = {hi * target.v_m_s, hi * target.w_rad_s};
+  } else {  // no scaling fits (e.g. still braking): limit each component on its own
+    last_.v_m_s = last_.v_m_s + Clamp(target.v_m_s - last_.v_m_s, dv);
+    last_.w_rad_s = last_.w_rad_s + Clamp(target.w_rad_s - last_.w_rad_s, dw);
+  }
+  last_ = {Clamp(last_.v_m_s, options_.max_speed_m_s), Clamp(last_.w_rad_s, options_.max_turn_rate_rad_s)};
+  // A zero target is reached exactly (λ = 1, or x + (-x) == 0), so the ramp down ends on a stop.
+  progress_.arrived = phase_ == Phase::kSettle && last_.v_m_s == 0.0 && last_.w_rad_s == 0.0;
+  progress_.waypoint_index = progress_.arrived ? waypoints_.size() : target_;
+  return last_;
+}
+
+VelocityCommand MotionController::Target(const Pose2D& pose) {
+  if (phase_ == Phase::kFollow) {
+    VelocityCommand cmd;
+    if (options_.kind == ControllerKind::kPurePursuit) {
+      if (PurePursuit(pose, &cmd)) return cmd;
+    } else {
+      const size_t last = waypoints_.size() - 1;
+      while (target_ < last && Dist(pose, waypoints_[target_]) < options_.intermediate_tolerance_m) ++target_;
+      if (target_ < last || Dist(pose, waypoints_[last]) >= options_.final_tolerance_m) {
+        return DriveTowards(pose, waypoints_[target_].x, waypoints_[target_].y, RtrStopDistance(pose));
+      }
+    }
+    // Within final tolerance: position is done for good, only the heading is left.
+    target_ = waypoints_.size() - 1;
+    phase_ = Phase::kAlign;
+  }
+  if (phase_ == Phase::kAlign) {
+    const double e = WrapAngle(waypoints_.back().theta - pose.theta);
+    if (std::abs(e) > options_.final_heading_tolerance_rad) return {0.0, TurnRate(e)};
+    phase_ = Phase::kSettle;
+  }
+  return {};
+}
+
+bool MotionController::PurePursuit(const Pose2D& pose, VelocityCommand* cmd) {
+  if (path_.empty()) {  // the polyline starts where the robot is when it starts following
+    path_.push_back(pose);
+    path_.insert(path_.end(), waypoints_.begin(), waypoints_.end());
+    arc_.assign(1, 0.0);
+    for (size_t i = 1; i < path_.size(); ++i) arc_.push_back(arc_.back() + Dist(path_[i - 1], path_[i]));
+  }
+  const double lookahead = options_.lookahead_m;
+  const double total = arc_.back();
+  // Project onto the nearest segment among those starting within one look-ahead of the current
+  // projection: progress never runs backwards nor jumps to a later pass of a self-crossing path.
+  double best = INFINITY;
+  const double window_end = projection_m_ + lookahead;
+  for (size_t k = segment_, first = segment_; k + 1 < path_.size() && (k == first || arc_[k] <= window_end); ++k) {
+    const Pose2D& a = path_[k];
+    const double dx = path_[k + 1].x - a.x, dy = path_[k + 1].y - a.y;
+    const double len = arc_[k + 1] - arc_[k];
+    const double t = len > 0.0 ? std::clamp(((pose.x - a.x) * dx + (pose.y - a.y) * dy) / (len * len), 0.0, 1.0) : 0.0;
+    const double d = std::hypot(a.x + t * dx - pose.x, a.y + t * dy - pose.y);
+    if (d < best) {
+      best = d;
+      segment_ = k;
+      projection_m_ = arc_[k] + t * len;
+    }
+  }
+  target_ = segment_;  // segment k ends at waypoint k
+  const double s_goal = std::min(projection_m_ + lookahead, total);
+  if (projection_m_ + lookahead >= total && Dist(pose, waypoints_.back()) < options_.final_tolerance_m) {
+    return false;
+  }
+
+  size_t j = segment_;
+  while (j + 2 < path_.size() && arc_[j + 1] < s_goal) ++j;
+  const double len = arc_[j + 1] - arc_[j];
+  const double u = len > 0.0 ? std::clamp((s_goal - arc_[j]) / len, 0.0, 1.0) : 1.0;
+  const Pose2D goal = Interpolate(path_[j], path_[j + 1], u);  // its heading is not used
+
+  const Pose2D local = pose.Inverse().Compose(goal);
+  const double e = std::atan2(local.y, local.x);
+  if (std::abs(e) > options_.turn_in_place_rad) {
+    *cmd = {0.0, TurnRate(e)};
+    return true;
+  }
+  const double chord2 = local.x * local.x + local.y * local.y;
+  // The arc through the look-ahead point tangent to the heading. The chord is used rather than
+  // lookahead_m so the law stays right when the point is clipped at the end or the robot is off
+  // the path; near the end v ∝ chord, which keeps ω = v·κ bounded.
+  const double kappa = chord2 > 0.0 ? 2.0 * local.y / chord2 : 0.0;
+  double v = Speed(std::sqrt(chord2) + total - s_goal);
+  if (std::abs(kappa) * v > options_.max_turn_rate_rad_s) v = options_.max_turn_rate_rad_s / std::abs(kappa);
+  *cmd = {v, v * kappa};
+  return true;
+}
+
+double MotionController::RtrStopDistance(const Pose2D& pose) const {
+  double d = Dist(pose, waypoints_[target_]);
+  double heading = std::atan2(waypoints_[target_].y - pose.y, waypoints_[target_].x - pose.x);
+  for (size_t j = target_; j + 1 < waypoints_.size(); ++j) {
+    const Pose2D& a = waypoints_[j];
+    const Pose2D& b = waypoints_[j + 1];
+    const double len = Dist(a, b);
+    if (len == 0.0) continue;
+    const double next = std::atan2(b.y - a.y, b.x - a.x);
+    if (std::abs(WrapAngle(next - heading)) > options_.turn_in_place_rad) break;  // stops to turn at a
+    d += len;
+    heading = next;
+  }
+  return d;
+}
+
+VelocityCommand MotionController::DriveTowards(const Pose2D& pose, double gx, double gy, double stop_distance_m) const {
+  const double e = Bearing(pose, gx, gy);
+  if (std::abs(e) > options_.turn_in_place_rad) return {0.0, TurnRate(e)};
+  return {Speed(stop_distance_m) * std::cos(e), TurnRate(e)};
+}
+
+double MotionController::Speed(double stop_distance_m) const {
+  const double d = std::max(stop_distance_m, 0.0);
+  return std::min({options_.max_speed_m_s, options_.k_distance * d, std::sqrt(2.0 * options_.max_accel_m_s2 * d)});
+}
+
+double MotionController::TurnRate(double heading_error_rad) const {
+  const double e = std::abs(heading_error_rad);
+  // The square-root term is the rate from which max_angular_accel still stops within e.
+  const double w = std::min({options_.k_bearing * e, options_.max_turn_rate_rad_s,
+                             std::sqrt(2.0 * options_.max_angular_accel_rad_s2 * e)});
+  return std::copysign(w, heading_error_rad);
+}
+
+Pose2D StepUnicycle(const Pose2D& p, const VelocityCommand& c, double dt_s) {
+  // The arc's chord has length ds·sin(dθ/2)/(dθ/2) and points along the mid-arc heading; this form
+  // stays exact as ω → 0, unlike the v/ω radius form.
+  const double half = 0.5 * c.w_rad_s * dt_s;
+  const double ds = c.v_m_s * dt_s;
+  const double chord = std::abs(half) < 1e-9 ? ds : ds * std::sin(half) / half;
+  const double mid = p.theta + half;
+  return {p.x + chord * std::cos(mid), p.y + chord * std::sin(mid), WrapAngle(p.theta + 2.0 * half)};
+}
+
+}  // namespace mbot::motion

@@ -1,0 +1,53 @@
+// Shared by the regression tests: run a shipped config with overrides into a fresh folder under
+// the test temp dir and read numbers back out of the JSON report it wrote.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "mbot/common/config.hpp"
+#include "pipeline.hpp"
+
+namespace mbot::app {
+
+// Runs config/<config_name> with `sets` (section.key=value) into TempDir()/<out_name>; returns the
+// text of <report> in that folder ("" when it was not written).
+inline std::string RunConfig(const std::string& config_name, const std::string& out_name,
+                             const std::vector<std::string>& sets, const std::string& report) {
+  auto c = config::Config::Load(std::string(MBOT_SOURCE_DIR) + "/config/" + config_name);
+  const std::string out = ::testing::TempDir() + "/" + out_name;
+  std::filesystem::remove_all(out);
+  c.Set("output.dir=" + out);
+  c.Set("pipeline.progress=off");
+  for (const auto& s : sets) c.Set(s);
+  auto plan = BuildPlan(c);
+  std::atomic<bool> stop{false};
+  RunPlan(plan, stop);
+  std::ifstream in(out + "/" + report);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// The number after the keys, found one after another in the JSON text (e.g. "slam_ate",
+// "aligned", "x_m", "rmse").
+inline double Get(const std::string& json, const std::vector<std::string>& keys) {
+  size_t pos = 0;
+  for (const auto& k : keys) {
+    pos = json.find("\"" + k + "\"", pos);
+    if (pos == std::string::npos) ADD_FAILURE() << "no key " << k;
+    if (pos == std::string::npos) return NAN;
+    pos += k.size() + 2;
+  }
+  pos = json.find(':', pos);
+  return std::stod(json.substr(pos + 1));
+}
+
+}  // namespace mbot::app
