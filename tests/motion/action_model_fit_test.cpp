@@ -69,6 +69,8 @@ void ExpectRecovers(double k1, double k2, uint32_t seed) {
   const Log log = MakeLog(3000, options.window_steps, k1, k2, seed);
   const ActionModelFit fit = FitActionModel(log.odometry, log.truth, options);
   ASSERT_TRUE(fit.converged) << fit.message;
+  ::testing::Test::RecordProperty("k1_fit_std", std::to_string(fit.k1) + " " + std::to_string(fit.k1_std));
+  ::testing::Test::RecordProperty("k2_fit_std", std::to_string(fit.k2) + " " + std::to_string(fit.k2_std));
   EXPECT_TRUE(fit.message.empty()) << fit.message;
   EXPECT_GT(fit.windows_used, 2700);
   EXPECT_GT(fit.windows_skipped, 100);

@@ -39,7 +39,11 @@ struct OdometryStageOptions {
 
 class OdometryStage : public Stage {
  public:
-  explicit OdometryStage(OdometryStageOptions o) : options_(std::move(o)) {
+  explicit OdometryStage(OdometryStageOptions o) : options_(std::move(o)) {}
+
+  // Built here rather than in the constructor: `--list-stages` constructs every stage with its
+  // defaults, which hold no wheel constants.
+  void Start(const RunContext& /*ctx*/) override {
     for (const auto& h : options_.headings) {
       motion::GyrodometryOptions f = options_.fusion;
       f.heading = kHeadings.at(h);

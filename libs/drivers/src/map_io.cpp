@@ -4,7 +4,6 @@
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/maps/CSimpleMap.h>
-#include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/poses/CPose3DPDF.h>
 #include <mrpt/serialization/CArchive.h>
 
@@ -23,6 +22,7 @@
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/strings.hpp"
 #include "mbot/mapping/log_odds_mapper.hpp"
+#include "mrpt_scan.hpp"
 
 namespace fs = std::filesystem;
 
@@ -232,16 +232,13 @@ mapping::OccupancyGrid ReadMrptSimplemap(const std::string& path, double resolut
     const mrpt::poses::CPose3D mean = pair.pose->getMeanVal();
     const motion::Pose2D robot{mean.x(), mean.y(), mean.yaw()};
     for (const auto& obs : *pair.sf) {
-      auto scan = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(obs);
-      if (!scan) continue;
-      const size_t n = scan->getScanSize();
-      std::vector<float> ranges(n), angles(n), fractions(n, 1.0f);  // a keyframe's scan has one pose
-      for (size_t i = 0; i < n; ++i) {
-        ranges[i] = scan->getScanRangeValidity(i) ? scan->getScanRange(i) : 0.0f;
-        angles[i] = static_cast<float>(scan->getScanAngle(i));
-      }
-      const motion::Pose2D sensor{scan->sensorPose.x(), scan->sensorPose.y(), scan->sensorPose.yaw()};
-      mapper.Insert(mapping::DeskewScan(ranges, angles, fractions, {}, sensor, scan->maxRange, scan_options), robot);
+      auto mrpt_scan = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(obs);
+      if (!mrpt_scan) continue;
+      const LidarScan scan = FromMrptScan(*mrpt_scan);
+      const std::vector<float> fractions(scan.ranges_m.size(), 1.0f);  // a keyframe's scan has one pose
+      mapper.Insert(mapping::DeskewScan(scan.ranges_m, scan.angles_rad, fractions, {}, scan.sensor_pose, scan.max_range_m,
+                                        scan_options),
+                    robot);
       ++scans;
     }
   }

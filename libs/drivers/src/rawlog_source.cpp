@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "mbot/common/log.hpp"
+#include "mrpt_scan.hpp"
 
 namespace mbot::drivers {
 namespace {
@@ -60,18 +61,8 @@ RawlogSource::RawlogSource(const SourceOptions& options) {
     auto& info = channels_[ev.channel];
     info.type = ClassName(*obs);
     if (auto scan = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(obs)) {
-      LidarScan s;
-      const size_t n = scan->getScanSize();
-      s.ranges_m.resize(n);
-      s.angles_rad.resize(n);
-      for (size_t i = 0; i < n; ++i) {
-        s.ranges_m[i] = scan->getScanRangeValidity(i) ? scan->getScanRange(i) : 0.0f;
-        s.angles_rad[i] = scan->getScanAngle(i);
-      }
-      s.max_range_m = scan->maxRange;
-      s.sensor_pose = {scan->sensorPose.x(), scan->sensorPose.y(), scan->sensorPose.yaw()};
       ev.kind = EventKind::kLidar;
-      ev.payload = std::move(s);
+      ev.payload = FromMrptScan(*scan);
     } else if (auto od = std::dynamic_pointer_cast<mrpt::obs::CObservationOdometry>(obs)) {
       ev.kind = EventKind::kOdometry;
       ev.payload = motion::Pose2D{od->odometry.x(), od->odometry.y(), od->odometry.phi()};

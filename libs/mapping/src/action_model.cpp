@@ -7,19 +7,6 @@
 
 namespace mbot::mapping {
 
-OdometryStep ActionModel::StepBetween(const motion::Pose2D& from, const motion::Pose2D& to) {
-  OdometryStep s;
-  const double dx = to.x - from.x, dy = to.y - from.y;
-  s.trans = std::hypot(dx, dy);
-  s.rot1 = s.trans > 1e-6 ? motion::WrapAngle(std::atan2(dy, dx) - from.theta) : 0.0;
-  if (std::abs(s.rot1) > M_PI / 2) {  // driving backwards
-    s.rot1 = motion::WrapAngle(s.rot1 + M_PI);
-    s.trans = -s.trans;
-  }
-  s.rot2 = motion::WrapAngle(to.theta - from.theta - s.rot1);
-  return s;
-}
-
 bool ActionModel::Moved(const motion::Pose2D& from, const motion::Pose2D& to) const {
   return std::hypot(to.x - from.x, to.y - from.y) >= options_.min_trans_m ||
          std::abs(motion::WrapAngle(to.theta - from.theta)) >= options_.min_rot_rad;

@@ -11,28 +11,8 @@
 namespace mbot::motion {
 namespace {
 
-// The odometry step split as mbot::mapping::ActionModel::StepBetween does it (re-derived here
-// because mbot_motion sits below mbot_mapping): a backward step keeps |rot1| ≤ π/2 and gets a
-// negative trans.
-struct Step {
-  double rot1 = 0, trans = 0, rot2 = 0;
-};
-
-Step StepBetween(const Pose2D& from, const Pose2D& to) {
-  Step s;
-  const double dx = to.x - from.x, dy = to.y - from.y;
-  s.trans = std::hypot(dx, dy);
-  s.rot1 = s.trans > 1e-6 ? WrapAngle(std::atan2(dy, dx) - from.theta) : 0.0;
-  if (std::abs(s.rot1) > M_PI / 2) {
-    s.rot1 = WrapAngle(s.rot1 + M_PI);
-    s.trans = -s.trans;
-  }
-  s.rot2 = WrapAngle(to.theta - from.theta - s.rot1);
-  return s;
-}
-
 // The same motion expressed with the opposite driving direction.
-Step Reversed(const Step& s) { return {WrapAngle(s.rot1 + M_PI), -s.trans, WrapAngle(s.rot2 - M_PI)}; }
+OdometryStep Reversed(const OdometryStep& s) { return {WrapAngle(s.rot1 + M_PI), -s.trans, WrapAngle(s.rot2 - M_PI)}; }
 
 bool Finite(const Pose2D& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.theta); }
 
@@ -113,8 +93,8 @@ ActionModelFit FitActionModel(const std::vector<Pose2D>& odometry, const std::ve
       continue;
     }
     ++translating;
-    const Step o = StepBetween(o0, o1);
-    Step t = StepBetween(t0, t1);
+    const OdometryStep o = OdometryStepBetween(o0, o1);
+    OdometryStep t = OdometryStepBetween(t0, t1);
     // Compare in odometry's driving direction, so noise that flips the canonical sign of the
     // true step does not show up as a half-turn error.
     if ((o.trans < 0) != (t.trans < 0)) t = Reversed(t);

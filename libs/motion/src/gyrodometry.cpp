@@ -28,46 +28,33 @@ void Gyrodometry::AddImu(int64_t t_us, double rate, double yaw, bool has_yaw) {
 }
 
 const Pose2D& Gyrodometry::AddEncoders(int64_t t_us, int64_t left_ticks, int64_t right_ticks) {
-  if (!started_) {
-    started_ = true;
-    left_ = left_ticks;
-    right_ = right_ticks;
-    last_enc_us_ = t_us;
-    gyro_turn_ = yaw_turn_ = 0.0;
-    return pose_;
-  }
-  const double dl = (left_ticks - left_) * wheels_.left_m_per_tick;
-  const double dr = (right_ticks - right_) * wheels_.right_m_per_tick;
-  left_ = left_ticks;
-  right_ = right_ticks;
-  moved_ = moved_ || dl != 0.0 || dr != 0.0;
+  WheelStep step = wheels_.Step(left_ticks, right_ticks);
   const double dt = (t_us - last_enc_us_) * 1e-6;
   last_enc_us_ = t_us;
-  const double ds = 0.5 * (dl + dr);
-  const double turn_enc = (dr - dl) / wheels_.wheel_base_m;
-  double turn = turn_enc;
+  if (!started_) {  // the first reading only sets the references
+    started_ = true;
+    gyro_turn_ = yaw_turn_ = 0.0;
+    return wheels_.pose();
+  }
+  moved_ = moved_ || step.distance_m != 0.0 || step.turn_rad != 0.0;
   switch (options_.heading) {
     case HeadingSource::kEncoders:
       break;
     case HeadingSource::kGyrodometry:
-      if (have_rate_ && dt > 0 && std::abs(gyro_turn_ - turn_enc) > options_.threshold_rad_s * dt) {
-        turn = gyro_turn_;
+      if (have_rate_ && dt > 0 && std::abs(gyro_turn_ - step.turn_rad) > options_.threshold_rad_s * dt) {
+        step.turn_rad = gyro_turn_;
         ++gyro_steps_;
       }
       break;
     case HeadingSource::kComplementary:
-      if (have_rate_) turn = options_.gyro_weight * gyro_turn_ + (1.0 - options_.gyro_weight) * turn_enc;
+      if (have_rate_) step.turn_rad = options_.gyro_weight * gyro_turn_ + (1.0 - options_.gyro_weight) * step.turn_rad;
       break;
     case HeadingSource::kImuYaw:
-      if (have_yaw_) turn = yaw_turn_;
+      if (have_yaw_) step.turn_rad = yaw_turn_;
       break;
   }
   gyro_turn_ = yaw_turn_ = 0.0;
-  const double mid = pose_.theta + 0.5 * turn;
-  pose_.x += ds * std::cos(mid);
-  pose_.y += ds * std::sin(mid);
-  pose_.theta = WrapAngle(pose_.theta + turn);
-  return pose_;
+  return wheels_.Apply(step);
 }
 
 }  // namespace mbot::motion

@@ -11,20 +11,24 @@ WheelOdometry::WheelOdometry(const WheelOdometryOptions& options) : options_(opt
   }
 }
 
-const Pose2D& WheelOdometry::Update(int64_t left_ticks, int64_t right_ticks) {
-  if (!started_) {
-    started_ = true;
-  } else {
+WheelStep WheelOdometry::Step(int64_t left_ticks, int64_t right_ticks) {
+  WheelStep step;
+  if (started_) {
     const double dl = (left_ticks - left_) * options_.left_m_per_tick;
     const double dr = (right_ticks - right_) * options_.right_m_per_tick;
-    const double ds = 0.5 * (dl + dr), dth = (dr - dl) / options_.wheel_base_m;
-    const double mid = pose_.theta + 0.5 * dth;
-    pose_.x += ds * std::cos(mid);
-    pose_.y += ds * std::sin(mid);
-    pose_.theta = WrapAngle(pose_.theta + dth);
+    step = {0.5 * (dl + dr), (dr - dl) / options_.wheel_base_m};
   }
+  started_ = true;
   left_ = left_ticks;
   right_ = right_ticks;
+  return step;
+}
+
+const Pose2D& WheelOdometry::Apply(const WheelStep& step) {
+  const double mid = pose_.theta + 0.5 * step.turn_rad;
+  pose_.x += step.distance_m * std::cos(mid);
+  pose_.y += step.distance_m * std::sin(mid);
+  pose_.theta = WrapAngle(pose_.theta + step.turn_rad);
   return pose_;
 }
 

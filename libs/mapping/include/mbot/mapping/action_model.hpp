@@ -20,16 +20,15 @@ struct ActionModelOptions {
   double min_rot_rad = 0.02;
 };
 
-struct OdometryStep {
-  double rot1 = 0, trans = 0, rot2 = 0;
-};
+using motion::OdometryStep;
 
 class ActionModel {
  public:
   explicit ActionModel(const ActionModelOptions& options) : options_(options) {}
-  // (rot1, trans, rot2) from one odometry pose to the next; a backward step keeps |rot1| ≤ π/2
-  // and gets a negative trans.
-  static OdometryStep StepBetween(const motion::Pose2D& from, const motion::Pose2D& to);
+  // (rot1, trans, rot2) from one odometry pose to the next (motion::OdometryStepBetween).
+  static OdometryStep StepBetween(const motion::Pose2D& from, const motion::Pose2D& to) {
+    return motion::OdometryStepBetween(from, to);
+  }
   // Whether the step from `from` to `to` is large enough to update the filter.
   bool Moved(const motion::Pose2D& from, const motion::Pose2D& to) const;
   // A sample of the particle's pose after `step`, drawn from the random stream `key`.

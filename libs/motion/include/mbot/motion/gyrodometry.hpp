@@ -35,16 +35,15 @@ class Gyrodometry {
   void AddImu(int64_t t_us, double yaw_rate_rad_s, double yaw_rad, bool has_yaw);
   // Cumulative encoder ticks; the first call sets the reference. Returns the pose.
   const Pose2D& AddEncoders(int64_t t_us, int64_t left_ticks, int64_t right_ticks);
-  const Pose2D& pose() const { return pose_; }
+  const Pose2D& pose() const { return wheels_.pose(); }
   double gyro_bias_rad_s() const { return bias_count_ ? bias_sum_ / bias_count_ : 0.0; }
   int gyro_steps() const { return gyro_steps_; }  // encoder steps whose heading came from the gyro
 
  private:
-  WheelOdometryOptions wheels_;
+  WheelOdometry wheels_;
   GyrodometryOptions options_;
-  Pose2D pose_;
   bool started_ = false, moved_ = false;
-  int64_t left_ = 0, right_ = 0, last_enc_us_ = 0;
+  int64_t last_enc_us_ = 0;
   // Gyro integration since the last encoder step.
   bool have_rate_ = false;
   int64_t last_imu_us_ = 0;

@@ -23,6 +23,14 @@ struct Pose2D {
 // Linear interpolation of position and shortest-arc interpolation of heading; s in [0, 1].
 Pose2D Interpolate(const Pose2D& a, const Pose2D& b, double s);
 
+// An odometry step split as the odometry motion model does (Thrun et al. §5.4): turn rot1 towards
+// the destination, drive trans, turn rot2. A backward step keeps |rot1| ≤ π/2 and gets a negative
+// trans; a step shorter than 1 µm is all rotation (rot1 = 0).
+struct OdometryStep {
+  double rot1 = 0, trans = 0, rot2 = 0;
+};
+OdometryStep OdometryStepBetween(const Pose2D& from, const Pose2D& to);
+
 struct TimedPose {
   int64_t t_us = 0;
   Pose2D pose;
