@@ -12,6 +12,7 @@
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/log.hpp"
+#include "mbot/drivers/sink.hpp"
 
 namespace mbot::app {
 namespace {
@@ -50,6 +51,32 @@ class Progress {
   bool lines_ = false;
   int last_decile_ = 0;
   std::chrono::steady_clock::time_point last_{};
+};
+
+// Delivers emitted events to the stages after the emitter and to the sink.
+class PipelineBus : public Bus {
+ public:
+  PipelineBus(std::vector<std::pair<std::string, std::unique_ptr<Stage>>>& stages, drivers::Sink* sink)
+      : stages_(stages), sink_(sink) {}
+  void Emit(const Stage* from, const drivers::Event& event) override {
+    size_t i = 0;
+    while (i < stages_.size() && stages_[i].second.get() != from) ++i;
+    for (size_t j = i + 1; j < stages_.size(); ++j) stages_[j].second->OnEvent(event);
+    if (sink_) sink_->Send(event);
+  }
+  void RequestStop(const std::string& reason) override {
+    if (!stop_) mbot::log::Info("pipeline: stopping: " + reason);
+    stop_ = true;
+    if (reason_.empty()) reason_ = reason;
+  }
+  bool stop_requested() const { return stop_; }
+  const std::string& reason() const { return reason_; }
+
+ private:
+  std::vector<std::pair<std::string, std::unique_ptr<Stage>>>& stages_;
+  drivers::Sink* sink_;
+  bool stop_ = false;
+  std::string reason_;
 };
 
 }  // namespace
@@ -109,14 +136,16 @@ RunSummary RunPlan(PipelinePlan& plan, const std::atomic<bool>& stop) {
   RunSummary summary;
   const auto wall0 = std::chrono::steady_clock::now();
   EnsureDirectory(plan.output.dir);
+  plan.source.seed = plan.pipeline.seed;
   std::unique_ptr<drivers::Source> source = drivers::OpenSource(plan.source);
-  RunContext ctx{plan.output.dir, plan.pipeline.seed, source.get(), plan.source.path};
+  PipelineBus bus(plan.stages, dynamic_cast<drivers::Sink*>(source.get()));
+  RunContext ctx{plan.output.dir, plan.pipeline.seed, source.get(), plan.source.path, &bus};
   for (auto& [name, stage] : plan.stages) stage->Start(ctx);
 
   Progress progress(plan.pipeline.progress);
   int64_t t0 = 0, t_last = 0;
   try {
-    while (!stop.load()) {
+    while (!stop.load() && !bus.stop_requested()) {
       if (plan.pipeline.max_events > 0 && summary.events >= plan.pipeline.max_events) break;
       std::optional<drivers::Event> ev = source->Next();
       if (!ev) break;
@@ -140,6 +169,7 @@ RunSummary RunPlan(PipelinePlan& plan, const std::atomic<bool>& stop) {
     throw;
   }
   summary.interrupted = stop.load();
+  summary.stopped_by = bus.reason();
   progress.Update(source->Progress(), summary.events, summary.data_seconds, true);
   progress.Done();
   for (auto& [name, stage] : plan.stages) stage->Finish(ctx, summary.interrupted);

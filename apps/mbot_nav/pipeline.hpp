@@ -40,6 +40,7 @@ struct RunSummary {
   double data_seconds = 0.0;
   double wall_seconds = 0.0;
   bool interrupted = false;
+  std::string stopped_by;  // the reason a stage gave when it ended the run, else ""
 };
 
 // Opens the source and runs every event through the stages until the end of the input or until

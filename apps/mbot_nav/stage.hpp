@@ -17,11 +17,26 @@ class Section;
 
 namespace mbot::app {
 
+class Stage;
+
+// How stages talk to what comes after them: an emitted event (a pose estimate, a map, a path, a
+// velocity command) goes at once to every later stage of the pipeline, in order, and then to the
+// sink (the simulator, live LCM) when the source is one. The same stages therefore run on a log
+// (where nothing listens to the commands), in the simulator and on a robot.
+class Bus {
+ public:
+  virtual ~Bus() = default;
+  virtual void Emit(const Stage* from, const drivers::Event& event) = 0;
+  // Ends the run after the current event; every stage's Finish then runs as at the end of the input.
+  virtual void RequestStop(const std::string& reason) = 0;
+};
+
 struct RunContext {
   std::string output_dir;     // exists when stages start
   uint64_t seed = 0;          // the one seed all randomness derives from
   const drivers::Source* source = nullptr;
   std::string source_path;
+  Bus* bus = nullptr;  // set by the pipeline; valid from Start to Finish
 };
 
 class Stage {

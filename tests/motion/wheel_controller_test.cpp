@@ -76,7 +76,7 @@ TEST(WheelController, StepSettlesWithin002RadPerSecondWithReportDefaults) {
   const WheelControllerOptions o;
   MotorCalibration model;
   const SpeedTrace r = Simulate(o, model, model.left, {{0.0, 0.0}, {0.1, 0.25}}, 4.0);
-  EXPECT_NEAR(r.target.back(), 0.25 / 0.0419, 1e-6);
+  EXPECT_NEAR(r.target.back(), 0.25 / RobotGeometry{}.wheel_radius_m, 1e-6);
   ExpectSettles(r, o.dt_s, 2.0, 0.02, /*max_sign_changes=*/1);  // no oscillation
 }
 

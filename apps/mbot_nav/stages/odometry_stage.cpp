@@ -12,6 +12,7 @@
 #include "mbot/drivers/map_io.hpp"
 #include "mbot/motion/gyrodometry.hpp"
 #include "mbot/motion/trajectory_error.hpp"
+#include "motion_config.hpp"
 #include "report.hpp"
 #include "stages.hpp"
 
@@ -150,12 +151,7 @@ StageType OdometryStageType() {
   return {"odometry", "recomputes dead reckoning from encoders and IMU (encoders, gyrodometry, complementary, IMU yaw) and scores it against ground truth",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             OdometryStageOptions o;
-            o.wheels.left_m_per_tick = s.GetDouble("left_m_per_tick", 0.0, "metres per left-wheel tick, signed with the encoder polarity");
-            o.wheels.right_m_per_tick = s.GetDouble("right_m_per_tick", 0.0, "metres per right-wheel tick, signed with the encoder polarity");
-            o.wheels.wheel_base_m = s.GetDouble("wheel_base_m", 0.155, "distance between the wheels' contact points", 1e-3);
-            if (!s.describing() && (o.wheels.left_m_per_tick == 0 || o.wheels.right_m_per_tick == 0)) {
-              s.Fail("left_m_per_tick", "both left_m_per_tick and right_m_per_tick are needed (non-zero)");
-            }
+            o.wheels = ParseWheelConstants(s);
             o.headings = s.GetList("headings", o.headings, "heading modes to run: encoders, gyrodometry, complementary, imu_yaw");
             for (const auto& h : o.headings) {
               if (!kHeadings.count(h)) s.Fail("headings", "unknown heading mode '" + h + "' (encoders, gyrodometry, complementary, imu_yaw)");

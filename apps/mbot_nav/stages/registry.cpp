@@ -8,7 +8,8 @@ const std::vector<StageType>& StageTypes() {
   static const std::vector<StageType> types = [] {
     std::vector<StageType> t = {InspectStageType(), TrajectoryWriterStageType(), MapWriterStageType(),
                                    AStarTestStageType(), MovingAiBenchmarkStageType(), ExplorationStageType(),
-                                   SlamStageType(), OdometryStageType()};
+                                   SlamStageType(), OdometryStageType(), MotorCalibrationStageType(),
+                                   ActionModelFitStageType(), MissionStageType(), RefereeStageType()};
     std::sort(t.begin(), t.end(), [](const StageType& a, const StageType& b) { return a.name < b.name; });
     return t;
   }();

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "mbot/common/config.hpp"
+#include "motion_config.hpp"
 
 namespace mbot::app {
 namespace {
@@ -54,13 +55,7 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
                                       "odometry from an odometry channel or integrated from encoder ticks");
   o.encoder_odometry = odo == "encoders";
   o.odometry_channel = s.GetString("odometry_channel", "", "odometry channel ('' = the first one seen)");
-  o.wheels.left_m_per_tick = s.GetDouble("left_m_per_tick", 0.0, "encoders: metres per left-wheel tick (signed)");
-  o.wheels.right_m_per_tick = s.GetDouble("right_m_per_tick", 0.0, "encoders: metres per right-wheel tick (signed)");
-  o.wheels.wheel_base_m = s.GetDouble("wheel_base_m", 0.0, "encoders: distance between the wheels", 0.0);
-  if (o.encoder_odometry && !s.describing() &&
-      (o.wheels.left_m_per_tick == 0 || o.wheels.right_m_per_tick == 0 || o.wheels.wheel_base_m <= 0)) {
-    s.Fail("odometry", "encoder odometry needs left_m_per_tick, right_m_per_tick and wheel_base_m");
-  }
+  o.wheels = ParseWheelConstants(s);  // used when odometry = encoders
   o.ground_truth_channel = s.GetString("ground_truth_channel", "", "ground-truth channel ('' = the first one seen)");
   o.reference_channel = s.GetString("reference_channel", "", "reference-pose channel ('' = the first one seen)");
   o.mapping_poses_from_reference =
@@ -183,6 +178,8 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
   o.map_basename = s.GetString("map_basename", o.map_basename, "map files in output.dir: .map, .pgm/.yaml, .png, .bt");
   o.png_scale = static_cast<int>(s.GetInt("png_scale", o.png_scale, "pixels per map cell in the PNG", 1, 16));
   o.particles_every = static_cast<int>(s.GetInt("particles_every", o.particles_every, "draw the particles every k-th scan (0: never)", 0));
+  o.publish_map_every = static_cast<int>(s.GetInt("publish_map_every", o.publish_map_every,
+                                                  "emit the map to later stages (planner, explorer) every k-th scan (0: never); the pose goes every scan", 0));
   o.octomap_height_m = s.GetDouble("octomap_height_m", o.octomap_height_m, "wall height in the OctoMap .bt (0: none)", 0.0);
   return o;
 }

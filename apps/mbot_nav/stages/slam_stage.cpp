@@ -46,6 +46,7 @@ class SlamStage : public Stage {
       : options_(std::move(o)), slam_(options_.slam, 0), noise_rng_(0) {}
 
   void Start(const RunContext& ctx) override {
+    bus_ = ctx.bus;
     slam_ = mapping::Slam(options_.slam, ctx.seed);
     noise_rng_.seed(ctx.seed ^ 0x6f646f6dULL);
     if (!options_.map_file.empty()) {
@@ -247,10 +248,23 @@ class SlamStage : public Stage {
     Pose2D odo;
     r.odometry = motion::InterpolateAt(odometry_, t_end, max_gap, &odo) ? odo : end_pose;
     records_.push_back(r);
+    Publish(r);
     if (options_.particles_every > 0 && !mapping_only && records_.size() % options_.particles_every == 1) {
       for (const mapping::Particle& q : slam_.filter().particles()) particle_snapshots_.push_back(q.pose);
     }
     TrackEvents(r);
+  }
+
+  // The estimate goes to the later stages (planner, explorer, controller) and the sink: the pose at
+  // the scan's time every scan, the map every publish_map_every scans (and the first).
+  void Publish(const ScanRecord& r) {
+    if (!bus_) return;
+    bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_POSE", EventKind::kPoseEstimate, r.slam});
+    const bool mapping = options_.slam.mode != mapping::SlamMode::kLocalization;
+    if (options_.publish_map_every > 0 && (records_.size() == 1 || (mapping && records_.size() % options_.publish_map_every == 0))) {
+      bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_MAP", EventKind::kMap,
+                                      std::make_shared<const mapping::OccupancyGrid>(slam_.map())});
+    }
   }
 
   static bool CoversTurn(const drivers::LidarScan& scan) {
@@ -455,6 +469,7 @@ class SlamStage : public Stage {
 
   SlamStageOptions options_;
   mapping::Slam slam_;
+  Bus* bus_ = nullptr;
   std::mt19937_64 noise_rng_;
   std::optional<motion::WheelOdometry> wheel_odometry_;
   std::string odometry_channel_, encoder_channel_, truth_channel_, reference_channel_, lidar_channel_;

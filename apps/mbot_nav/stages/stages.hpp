@@ -13,5 +13,9 @@ StageType MovingAiBenchmarkStageType();
 StageType ExplorationStageType();
 StageType SlamStageType();
 StageType OdometryStageType();
+StageType MotorCalibrationStageType();
+StageType ActionModelFitStageType();
+StageType MissionStageType();
+StageType RefereeStageType();
 
 }  // namespace mbot::app

@@ -306,7 +306,7 @@ std::map<int64_t, Entry> BuildTable() {
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
         mbot_lcm_msgs::mbot_motor_vel_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
-        ev->kind = EventKind::kOther;  // measured wheel speeds, not a command
+        ev->kind = EventKind::kWheelSpeed;  // measured wheel speeds, not a command
         ev->stamp_us = m.utime;
         ev->payload = MotorCommand{MotorCommand::Kind::kWheelSpeed, m.velocity[0], m.velocity[1]};
         return true;

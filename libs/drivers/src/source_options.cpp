@@ -2,6 +2,8 @@
 
 #include <zlib.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -12,8 +14,10 @@
 #include "mbot/common/config.hpp"
 #include "mbot/drivers/lcm_log.hpp"
 #include "mbot/drivers/map_io.hpp"
+#include "motor_samples_source.hpp"
 #include "planning_cases_source.hpp"
 #include "rawlog_source.hpp"
+#include "sim_source.hpp"
 
 namespace mbot::drivers {
 namespace {
@@ -39,13 +43,95 @@ class MapSource : public Source {
   bool done_ = false;
 };
 
+bool EndsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// "x, y, theta_deg" → a pose (theta in radians).
+motion::Pose2D ParsePoseKey(config::Section& s, const std::string& key, const std::vector<std::string>& items) {
+  if (items.size() != 3) {
+    s.Fail(key, "expected x, y, theta_deg (3 numbers), got " + std::to_string(items.size()) + " items");
+  }
+  double v[3];
+  for (int i = 0; i < 3; ++i) {
+    char* end = nullptr;
+    v[i] = std::strtod(items[i].c_str(), &end);
+    if (*end != '\0' || !std::isfinite(v[i])) s.Fail(key, "expected a finite number, got '" + items[i] + "'");
+  }
+  return {v[0], v[1], motion::WrapAngle(v[2] * M_PI / 180.0)};
+}
+
 }  // namespace
+
+SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& world_path) {
+  // Every key is documented as the simulator's: they exist only when the source is the simulator.
+  const auto doc = [](const char* text) { return std::string("simulator: ") + text; };
+  SimSourceOptions o;
+  const std::vector<std::string> start =
+      s.GetList("start", {}, doc("where the robot starts, in the world frame: x [m], y [m], theta [deg]; "
+                                 "default: the arena's 'start' pose (required for a map world)"));
+  if (!start.empty()) {
+    o.start = ParsePoseKey(s, "start", start);
+  } else if (!s.describing() && !EndsWith(world_path, ".arena")) {
+    s.Fail("start", "required: the world '" + world_path + "' is a map, which names no start pose");
+  }
+  o.duration_s = s.GetDouble("duration_s", o.duration_s, doc("simulated time after which the run ends [s]"), 0.001, 1e6);
+
+  SimRobotOptions& r = o.robot;
+  r.physics_dt_s = s.GetDouble("physics_dt_s", r.physics_dt_s, doc("integration step of the motion [s]"), 1e-4, 0.02);
+  r.footprint_radius_m =
+      s.GetDouble("footprint_radius_m", r.footprint_radius_m,
+                  doc("radius of the robot's disc footprint; touching a wall with it stops the robot [m]"), 0.01, 1.0);
+  r.left_motor_gain =
+      s.GetDouble("left_motor_gain", r.left_motor_gain,
+                  doc("true left wheel speed / the speed the motor model gives its duty (per-wheel difference)"), 0.5, 1.5);
+  r.right_motor_gain = s.GetDouble("right_motor_gain", r.right_motor_gain,
+                                   doc("true right wheel speed / the speed the motor model gives its duty"), 0.5, 1.5);
+  r.motor_time_constant_s =
+      s.GetDouble("motor_time_constant_s", r.motor_time_constant_s,
+                  doc("first-order lag of a wheel's speed behind its duty's steady state [s]"), 0.0, 1.0);
+  r.slip_stddev = s.GetDouble("slip_stddev", r.slip_stddev,
+                              doc("relative error of each wheel's ground speed against its rotation (std. dev.)"), 0.0, 0.5);
+  r.slip_interval_s =
+      s.GetDouble("slip_interval_s", r.slip_interval_s, doc("how often each wheel's slip is redrawn [s]"), 0.001, 10.0);
+  const double firmware_rate_hz =
+      s.GetDouble("firmware_rate_hz", 1.0 / r.controller.dt_s,
+                  doc("rate of the firmware's wheel-speed controller and its encoder, wheel-speed, odometry and PWM "
+                      "messages [Hz]"),
+                  5.0, 1000.0);
+  r.controller.dt_s = 1.0 / firmware_rate_hz;
+  r.ground_truth_rate_hz =
+      s.GetDouble("ground_truth_rate_hz", r.ground_truth_rate_hz, doc("rate of the TRUE_POSE messages [Hz]"), 1.0, 1000.0);
+
+  SimImuOptions& imu = r.imu;
+  imu.rate_hz = s.GetDouble("imu_rate_hz", imu.rate_hz, doc("rate of the IMU messages [Hz]"), 1.0, 1000.0);
+  imu.gyro_noise_rad_s = s.GetDouble("gyro_noise_rad_s", imu.gyro_noise_rad_s,
+                                     doc("white noise of each gyro sample, standard deviation [rad/s]"), 0.0, 1.0);
+  imu.gyro_bias_initial_rad_s = s.GetDouble("gyro_bias_initial_rad_s", imu.gyro_bias_initial_rad_s,
+                                            doc("standard deviation of the gyro bias at start [rad/s]"), 0.0, 1.0);
+  imu.gyro_bias_walk_rad_s_sqrt_s = s.GetDouble("gyro_bias_walk_rad_s_sqrt_s", imu.gyro_bias_walk_rad_s_sqrt_s,
+                                                doc("random walk of the gyro bias [rad/s/sqrt(s)]"), 0.0, 1.0);
+
+  SimLidarOptions& l = r.lidar;
+  l.rate_hz = s.GetDouble("lidar_rate_hz", l.rate_hz, doc("lidar revolutions per second [Hz]"), 0.5, 100.0);
+  l.beams = static_cast<int>(s.GetInt("lidar_beams", l.beams, doc("lidar beams per revolution"), 8, 100000));
+  l.max_range_m = s.GetDouble("lidar_max_range_m", l.max_range_m,
+                              doc("lidar range limit; farther walls give no return [m]"), 0.5, 100.0);
+  l.min_range_m =
+      s.GetDouble("lidar_min_range_m", l.min_range_m, doc("closer lidar returns are dropped [m]"), 0.0, 10.0);
+  if (l.min_range_m >= l.max_range_m) s.Fail("lidar_min_range_m", "must be below lidar_max_range_m");
+  l.range_noise_m =
+      s.GetDouble("lidar_range_noise_m", l.range_noise_m, doc("lidar range noise, standard deviation [m]"), 0.0, 1.0);
+  l.dropout =
+      s.GetDouble("lidar_dropout", l.dropout, doc("probability that a lidar beam gives no return"), 0.0, 1.0);
+  return o;
+}
 
 SourceOptions ParseSourceOptions(config::Section& s) {
   SourceOptions o;
-  o.type = s.GetChoice("type", o.type, {"auto", "lcm_log", "rawlog", "carmen", "map", "astar_cases", "movingai"},
-                       "input format; auto detects it from the file's content");
-  o.path = s.RequirePath("path", "the dataset to read (LCM log, MRPT rawlog, CARMEN log, map file, botlab A* poses file or folder, Moving AI .scen)");
+  o.type = s.GetChoice("type", o.type, {"auto", "lcm_log", "rawlog", "carmen", "map", "astar_cases", "movingai", "motor_csv", "sim"},
+                       "input format; auto detects it from the file's content (an .arena file is the simulator's world)");
+  o.path = s.RequirePath("path", "the dataset to read (LCM log, MRPT rawlog, CARMEN log, map file, botlab A* poses file or folder, Moving AI .scen), or the simulator's world (.arena or a map)");
   auto& r = o.roles;
   r.odometry = s.GetList("odometry_channels", r.odometry, "LCM channels whose poses are the robot's odometry");
   r.ground_truth = s.GetList("ground_truth_channels", r.ground_truth, "LCM channels carrying ground-truth poses");
@@ -60,6 +146,11 @@ SourceOptions ParseSourceOptions(config::Section& s) {
   o.reorder_window_us = static_cast<int64_t>(
       1e6 * s.GetDouble("reorder_window_s", o.reorder_window_us * 1e-6,
                         "LCM log records are re-sorted by event time within this window [s]", 0.0, 10.0));
+  // The simulator's keys exist only for the simulator (elsewhere they are unknown keys); --list-stages
+  // (describe mode) documents them too.
+  if (o.type == "sim" || (o.type == "auto" && EndsWith(o.path, ".arena")) || s.describing()) {
+    o.sim = ParseSimSourceOptions(s, o.path);
+  }
   return o;
 }
 
@@ -67,11 +158,13 @@ std::string DetectFormat(const std::string& path) {
   std::string cases;
   if (IsPlanningCasesPath(path, &cases)) return cases;
   if (!std::filesystem::is_regular_file(path)) throw std::runtime_error(path + ": no such file");
+  if (EndsWith(path, ".arena")) return "sim";
   if (IsMapFile(path)) return "map";
   const auto ends_with = [&path](const std::string& s) {
     return path.size() >= s.size() && path.compare(path.size() - s.size(), s.size(), s) == 0;
   };
   if (ends_with(".rawlog") || ends_with(".rawlog.gz")) return "rawlog";
+  if (ends_with(".csv") && IsMotorSamplesFile(path)) return "motor_csv";
   unsigned char head[4] = {0, 0, 0, 0};
   {
     std::ifstream in(path, std::ios::binary);
@@ -92,7 +185,7 @@ std::string DetectFormat(const std::string& path) {
       }
     }
   }
-  throw std::runtime_error(path + ": unrecognised format (not an LCM log, MRPT rawlog, CARMEN log or map); set source.type");
+  throw std::runtime_error(path + ": unrecognised format (not an LCM log, MRPT rawlog, CARMEN log, map or arena); set source.type");
 }
 
 std::unique_ptr<Source> OpenSource(const SourceOptions& options) {
@@ -102,6 +195,8 @@ std::unique_ptr<Source> OpenSource(const SourceOptions& options) {
   if (type == "carmen") return std::make_unique<CarmenSource>(options);
   if (type == "map") return std::make_unique<MapSource>(options.path);
   if (type == "astar_cases" || type == "movingai") return std::make_unique<PlanningCasesSource>(options.path, type);
+  if (type == "sim") return std::make_unique<SimSource>(options);
+  if (type == "motor_csv") return std::make_unique<MotorSamplesSource>(options.path);
   throw std::runtime_error("source type '" + type + "' is not known");
 }
 
@@ -116,6 +211,12 @@ const char* ToString(EventKind kind) {
     case EventKind::kReferencePose: return "reference pose";
     case EventKind::kMap: return "map";
     case EventKind::kPlanRequest: return "plan request";
+    case EventKind::kWheelSpeed: return "wheel speed";
+    case EventKind::kMotorSample: return "motor sample";
+    case EventKind::kCollision: return "collision";
+    case EventKind::kPoseEstimate: return "pose estimate";
+    case EventKind::kPath: return "path";
+    case EventKind::kStatus: return "status";
     case EventKind::kOther: return "other";
   }
   return "?";

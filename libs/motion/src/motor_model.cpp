@@ -41,7 +41,7 @@ LineFit FitLine(const std::vector<std::pair<double, double>>& samples, const Mot
   ceres::Problem problem;
   for (const auto& [speed, duty] : samples) {
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<LineResidual, 1, 1, 1>(new LineResidual{speed, duty}),
-                             new ceres::HuberLoss(loss_scale), &fit.line.slope, &fit.line.punch);
+                             new ceres::CauchyLoss(loss_scale), &fit.line.slope, &fit.line.punch);
   }
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;

@@ -58,6 +58,25 @@ struct PlanRequest {
   int bucket = -1;               // Moving AI difficulty bucket, else -1
 };
 
+// One steady-state sample of a motor calibration run (the BeagleBone calibration CSV's rows): the
+// duty sent to one wheel and the wheel speed its encoder measured, raw signs.
+struct WheelSample {
+  int channel = 0;  // the motor channel number as the file gives it (the stage maps it to a wheel)
+  double duty = 0.0;
+  double speed_rad_s = 0.0;
+};
+
+// A path (planned or sent by a GUI): poses in the map frame.
+struct Path {
+  std::vector<motion::Pose2D> poses;
+};
+
+// What a stage reports about its task (exploration, competition event), botlab-style.
+struct Status {
+  std::string state;   // e.g. "exploring", "returning_home", "completed", "failed"
+  std::string detail;  // free text
+};
+
 enum class EventKind {
   kLidar,          // LidarScan
   kOdometry,       // Pose2D, the robot's own dead-reckoning
@@ -68,13 +87,20 @@ enum class EventKind {
   kReferencePose,  // Pose2D from another estimator (staff SLAM, corrected CARMEN poses)
   kMap,            // shared_ptr<const OccupancyGrid>
   kPlanRequest,    // PlanRequest, on the channel named after its map
+  kWheelSpeed,     // MotorCommand{kWheelSpeed}: wheel speeds measured by the robot (not a command)
+  kMotorSample,    // WheelSample from a calibration file
+  kCollision,      // Pose2D: the true pose at which the simulated robot touched a wall
+  kPoseEstimate,   // Pose2D: the stack's own pose estimate (SLAM / localization output)
+  kPath,           // Path: the planned path the controller follows
+  kStatus,         // Status of a task (exploration, competition event)
   kOther,          // recognised but not used by the pipeline (particles, time sync, status …)
 };
 
 const char* ToString(EventKind kind);
 
 using Payload = std::variant<std::monostate, LidarScan, motion::Pose2D, EncoderTicks, Imu,
-                             MotorCommand, std::shared_ptr<const mapping::OccupancyGrid>, PlanRequest>;
+                             MotorCommand, std::shared_ptr<const mapping::OccupancyGrid>, PlanRequest, WheelSample,
+                             Path, Status>;
 
 struct Event {
   int64_t t_us = 0;       // event (reception / log) time; the order of the stream

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "mbot/drivers/sim_source_options.hpp"
 #include "mbot/drivers/source.hpp"
 
 namespace mbot::config {
@@ -25,25 +26,31 @@ struct ChannelRoles {
 };
 
 struct SourceOptions {
-  std::string type = "auto";  // auto, lcm_log, rawlog, carmen, map, astar_cases, movingai
-  std::string path;           // required
+  std::string type = "auto";  // auto, lcm_log, rawlog, carmen, map, astar_cases, movingai, sim
+  std::string path;           // required; for sim, the world file
   ChannelRoles roles;
   // CARMEN logs with old FLASER lines give no range limit; beams at or beyond it are no-returns.
   double carmen_max_range_m = 81.0;
   // LCM log records are re-sorted by event time within this window (lcm-logger writes them in
   // arrival order, which can run a few ms backwards).
   int64_t reorder_window_us = 100000;
+  // Seed of the simulator's noise ([pipeline] seed, copied here by the pipeline; not a [source] key).
+  uint64_t seed = 1;
+  // The simulator's options: read only when the source is the simulator (type = sim, or auto with
+  // an `.arena` path).
+  SimSourceOptions sim;
 };
 
 // Reads [source]. Throws config::ConfigError naming the key on bad values.
 SourceOptions ParseSourceOptions(config::Section& section);
 
 // Opens the input named by the options, detecting the format from its content when type = auto.
+// The simulator (type sim) is also a Sink: dynamic_cast the source to drivers::Sink to drive it.
 // Throws std::runtime_error naming the path when it cannot be read or recognised.
 std::unique_ptr<Source> OpenSource(const SourceOptions& options);
 
 // The format OpenSource would pick for `path` ("lcm_log", "rawlog", "carmen", "map", "astar_cases",
-// "movingai").
+// "movingai", "sim" for an `.arena` world).
 std::string DetectFormat(const std::string& path);
 
 }  // namespace mbot::drivers

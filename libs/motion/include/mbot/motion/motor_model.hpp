@@ -46,7 +46,7 @@ struct MotorFitOptions {
   int right_motor_polarity = 1, right_encoder_polarity = 1;
   double min_speed_rad_s = 0.5;  // slower samples are stalls (the wheel is still breaking away): not fitted
   double min_duty = 0.02;        // samples with a smaller duty say nothing about the line
-  double loss_scale = 0.02;      // Huber scale, in duty units: residuals beyond it count linearly
+  double loss_scale = 0.02;      // Cauchy loss scale, in duty units: residuals well beyond it (slips) barely count
   double max_abs_slope = 0.10;   // the reports' acceptance criterion
   double max_abs_punch = 0.10;
   int min_samples = 5;           // per wheel and direction

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "mbot/motion/motor_model.hpp"
+#include "mbot/motion/robot_geometry.hpp"
 
 namespace mbot::motion {
 
@@ -21,16 +22,6 @@ class LowPassFilter {
  private:
   double alpha_;
   double y_ = 0.0;
-};
-
-// The classic MBot's geometry (mbot_classic firmware): 78:1 gearbox, 20 counts per motor turn,
-// 41.9 mm wheel radius, 77.5 mm from the centre to each wheel.
-struct RobotGeometry {
-  double wheel_radius_m = 0.0419;
-  double base_radius_m = 0.0775;  // half the distance between the wheels
-  double gear_ratio = 78.0;
-  double encoder_resolution = 20.0;  // counts per motor revolution
-  double RadPerTick() const { return 2.0 * 3.14159265358979323846 / (gear_ratio * encoder_resolution); }
 };
 
 struct WheelControllerOptions {

@@ -1,0 +1,327 @@
+// `mission`: the robot's autonomy after SLAM — what to do (follow a circuit of waypoints, or explore
+// and return home), how to get there (the explorer's A* paths) and the motion controller that turns
+// the pose into velocity commands. It runs on every odometry message (the firmware's 50 Hz): the
+// pose is the latest SLAM pose moved on by the odometry since that scan, the command goes out on
+// MBOT_VEL_CMD (to the simulator, or to a robot over LCM). States go out as kStatus events.
+// The same stage drives the simulator, a live robot, and does nothing harmful on a log (nobody
+// listens to its commands there).
+#include <cmath>
+#include <deque>
+#include <iostream>
+
+#include "mbot/common/atomic_file.hpp"
+#include "mbot/common/config.hpp"
+#include "mbot/common/log.hpp"
+#include "mbot/drivers/sim_world.hpp"
+#include "mbot/motion/motion_controller.hpp"
+#include "mbot/planning/exploration.hpp"
+#include "mbot/planning/planning_config.hpp"
+#include "report.hpp"
+#include "stages.hpp"
+
+namespace mbot::app {
+namespace {
+
+using drivers::EventKind;
+using motion::Pose2D;
+using motion::TimedPose;
+
+enum class Task { kWaypoints, kExplore };
+
+struct MissionOptions {
+  Task task = Task::kWaypoints;
+  std::vector<Pose2D> waypoints;        // start frame; empty with waypoints_from_arena
+  bool waypoints_from_arena = true;     // the source's arena file, `waypoint` poses relative to `start`
+  motion::MotionControllerOptions controller;
+  planning::ExplorationOptions exploration;
+  double explore_period_s = 0.25;       // explorer updates at most this often [s]
+  double start_delay_s = 0.5;           // stand still this long after the first SLAM pose (map the start)
+  double max_pose_age_s = 1.0;          // stop when the SLAM pose is older than this [s]
+  // The wheels answer a command late (the firmware filters v, ω and the PWM; the motors lag): the
+  // controller is given the pose predicted this far ahead at the measured velocity.
+  double control_lag_s = 0.2;
+  int max_corrections = 5;
+  double stuck_s = 1.0;                 // commanded to move but not moving this long: back off
+  double backoff_s = 0.6;               // reversing at 0.1 m/s              // drives back to the final pose when it stopped outside the tolerances
+  std::string status_channel = "MISSION_STATUS";
+};
+
+class MissionStage : public Stage {
+ public:
+  explicit MissionStage(MissionOptions o)
+      : o_(std::move(o)), controller_(o_.controller), explorer_(o_.exploration) {}
+
+  void Start(const RunContext& ctx) override {
+    bus_ = ctx.bus;
+    if (o_.task == Task::kWaypoints && o_.waypoints.empty()) {
+      if (!o_.waypoints_from_arena) throw std::runtime_error("mission: no waypoints given");
+      const drivers::World world = drivers::World::Load(ctx.source_path);
+      const auto starts = world.PosesLabelled("start");
+      const auto points = world.PosesLabelled("waypoint");
+      if (starts.empty() || points.empty()) {
+        throw std::runtime_error("mission: waypoints = arena, but " + ctx.source_path +
+                                 " has no 'pose start' and 'pose waypoint' lines");
+      }
+      const Pose2D inv = starts[0].Inverse();
+      for (const Pose2D& w : points) o_.waypoints.push_back(inv.Compose(w));
+    }
+  }
+
+  void OnEvent(const drivers::Event& ev) override {
+    switch (ev.kind) {
+      case EventKind::kPoseEstimate:
+        slam_ = {ev.t_us, std::get<Pose2D>(ev.payload)};
+        has_slam_ = true;
+        if (first_slam_us_ < 0) first_slam_us_ = ev.t_us;
+        return;
+      case EventKind::kMap:
+        map_ = std::get<std::shared_ptr<const mapping::OccupancyGrid>>(ev.payload);
+        return;
+      case EventKind::kOdometry:
+        odometry_.push_back({ev.t_us, std::get<Pose2D>(ev.payload)});
+        while (odometry_.size() > 2 && odometry_.front().t_us < ev.t_us - 5'000'000) odometry_.pop_front();
+        Control(ev.t_us);
+        return;
+      default:
+        return;
+    }
+  }
+
+  void Finish(const RunContext& ctx, bool interrupted) override {
+    std::ostringstream j;
+    j << "{\n  \"task\": " << JsonString(o_.task == Task::kWaypoints ? "waypoints" : "explore")
+      << ",\n  \"state\": " << JsonString(state_) << ",\n  \"detail\": " << JsonString(detail_)
+      << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"commands\": " << commands_
+      << ",\n  \"paths\": " << paths_ << ",\n  \"stale_pose_stops\": " << stale_stops_
+      << ",\n  \"corrections\": " << corrections_ << ",\n  \"stall_recoveries\": " << recoveries_ << "\n}\n";
+    WriteFileAtomically(ctx.output_dir + "/mission.json", [&](std::ostream& out) { out << j.str(); });
+  }
+
+ private:
+  // The pose now: the SLAM pose at its scan, moved on by what odometry says happened since.
+  bool PoseNow(int64_t t_us, Pose2D* pose) const {
+    if (!has_slam_ || odometry_.empty()) return false;
+    Pose2D odo_then;
+    const std::vector<TimedPose> odo(odometry_.begin(), odometry_.end());
+    if (!motion::InterpolateAt(odo, slam_.t_us, 200'000, &odo_then)) return false;
+    const Pose2D delta = odo_then.Inverse().Compose(odometry_.back().pose);
+    *pose = slam_.pose.Compose(delta);
+    (void)t_us;
+    return true;
+  }
+
+  // A robot pushing against a wall stalls: its wheels (hence odometry) stop while it is told to
+  // drive. After `stuck_s` of that, back off for `backoff_s`, then let the controller (and the
+  // explorer, which replans from the new pose) take over again.
+  bool Recovering(int64_t t_us) {
+    if (t_us < backoff_until_us_) {
+      Send(-0.1, 0.0, t_us);
+      return true;
+    }
+    const motion::VelocityCommand v = MeasuredVelocity();
+    const bool pushing = std::abs(last_command_.v_m_s) > 0.05 || std::abs(last_command_.w_rad_s) > 0.3;
+    const bool still = std::abs(v.v_m_s) < 0.01 && std::abs(v.w_rad_s) < 0.05;
+    if (!pushing || !still) {
+      stuck_since_us_ = -1;
+      return false;
+    }
+    if (stuck_since_us_ < 0) stuck_since_us_ = t_us;
+    if ((t_us - stuck_since_us_) * 1e-6 < o_.stuck_s) return false;
+    ++recoveries_;
+    mbot::log::Warn("mission: stalled for " + Num(o_.stuck_s, 3) + " s while commanded to move: backing off");
+    stuck_since_us_ = -1;
+    last_command_ = {};
+    backoff_until_us_ = t_us + static_cast<int64_t>(o_.backoff_s * 1e6);
+    last_explore_us_ = -1;  // replan as soon as the back-off ends
+    Send(-0.1, 0.0, t_us);
+    return true;
+  }
+
+  // At the final pose: the controller has stopped commanding, but the wheels lag, so wait until the
+  // robot stands still, then check the pose; outside the tolerances, drive to it again.
+  void Settle(const Pose2D& pose, int64_t t_us) {
+    const motion::VelocityCommand v = MeasuredVelocity();
+    if (std::abs(v.v_m_s) > 0.005 || std::abs(v.w_rad_s) > 0.02) return;
+    const Pose2D goal = o_.task == Task::kWaypoints ? o_.waypoints.back() : explorer_.home();
+    const double d = std::hypot(goal.x - pose.x, goal.y - pose.y);
+    const double e = std::abs(motion::WrapAngle(goal.theta - pose.theta));
+    const std::string done = o_.task == Task::kWaypoints ? "circuit driven" : "explored and home";
+    if ((d <= o_.controller.final_tolerance_m && e <= o_.controller.final_heading_tolerance_rad) || corrections_ >= o_.max_corrections) {
+      SetState("completed", done + " (" + std::to_string(corrections_) + " corrections; off by " + Num(d, 3) + " m, " +
+                                Num(e * 180 / M_PI, 3) + " deg by its own estimate)", t_us);
+      return;
+    }
+    ++corrections_;
+    SetPath({goal}, t_us);
+  }
+
+  // Body velocity from odometry over the last 0.1 s.
+  motion::VelocityCommand MeasuredVelocity() const {
+    if (odometry_.size() < 2) return {};
+    const TimedPose& now = odometry_.back();
+    size_t i = odometry_.size() - 1;
+    while (i > 0 && now.t_us - odometry_[i].t_us < 100'000) --i;
+    const double dt = (now.t_us - odometry_[i].t_us) * 1e-6;
+    if (dt <= 0) return {};
+    const Pose2D d = odometry_[i].pose.Inverse().Compose(now.pose);
+    return {d.x / dt, d.theta / dt};
+  }
+
+  // The pose `control_lag_s` ahead at the velocity odometry measured over the last 0.1 s.
+  Pose2D Predict(const Pose2D& pose) const {
+    if (o_.control_lag_s <= 0) return pose;
+    return motion::StepUnicycle(pose, MeasuredVelocity(), o_.control_lag_s);
+  }
+
+  void SetState(const std::string& state, const std::string& detail, int64_t t_us) {
+    if (state == state_ && detail == detail_) return;
+    state_ = state, detail_ = detail;
+    mbot::log::Info("mission: " + state + (detail.empty() ? "" : " (" + detail + ")"));
+    if (bus_) bus_->Emit(this, drivers::Event{t_us, t_us, o_.status_channel, EventKind::kStatus, drivers::Status{state, detail}});
+  }
+
+  void SetPath(const std::vector<Pose2D>& path, int64_t t_us) {
+    controller_.SetPath(path);
+    ++paths_;
+    if (bus_) bus_->Emit(this, drivers::Event{t_us, t_us, "CONTROLLER_PATH", EventKind::kPath, drivers::Path{path}});
+  }
+
+  void Send(double v, double w, int64_t t_us) {
+    ++commands_;
+    if (bus_) {
+      bus_->Emit(this, drivers::Event{t_us, t_us, "MBOT_VEL_CMD", EventKind::kMotorCommand,
+                                      drivers::MotorCommand{drivers::MotorCommand::Kind::kVelocity, v, w}});
+    }
+  }
+
+  void Control(int64_t t_us) {
+    const double dt = last_control_us_ >= 0 ? (t_us - last_control_us_) * 1e-6 : 0.0;
+    last_control_us_ = t_us;
+    Pose2D pose;
+    if (!PoseNow(t_us, &pose) || (t_us - first_slam_us_) * 1e-6 < o_.start_delay_s) {
+      SetState("initializing", "waiting for SLAM", t_us);
+      Send(0, 0, t_us);
+      return;
+    }
+    if ((t_us - slam_.t_us) * 1e-6 > o_.max_pose_age_s) {
+      ++stale_stops_;
+      SetState(state_, "SLAM pose stale: stopped", t_us);
+      Send(0, 0, t_us);
+      return;
+    }
+    if (state_ == "completed" || state_ == "failed") {
+      Send(0, 0, t_us);
+      return;
+    }
+    if (o_.task == Task::kWaypoints) {
+      if (!started_) {
+        started_ = true;
+        SetPath(o_.waypoints, t_us);
+        SetState("driving", "circuit of " + std::to_string(o_.waypoints.size()) + " waypoints", t_us);
+      }
+    } else if (!explored_ && map_ && (last_explore_us_ < 0 || (t_us - last_explore_us_) * 1e-6 >= o_.explore_period_s)) {
+      last_explore_us_ = t_us;
+      const planning::ExplorationUpdate u = explorer_.Update(*map_, pose, t_us * 1e-6);
+      if (u.state == planning::ExplorationState::kFailed) {
+        SetState("failed", explorer_.failure_reason(), t_us);
+        Send(0, 0, t_us);
+        return;
+      }
+      if (u.new_path || u.state == planning::ExplorationState::kCompleted) {
+        // Home is a pose: the way back ends in the heading the robot started with.
+        std::vector<Pose2D> path = u.path;
+        if (u.state == planning::ExplorationState::kCompleted) path = {explorer_.home()};
+        if (u.state != planning::ExplorationState::kExploring && !path.empty()) path.back().theta = explorer_.home().theta;
+        SetPath(path, t_us);
+      }
+      if (u.state == planning::ExplorationState::kCompleted) {
+        explored_ = true;  // at home: the controller settles the final pose, then the mission is complete
+        SetState("returning_home", "aligning at home", t_us);
+      } else {
+        SetState(planning::ToString(u.state), u.reason, t_us);
+      }
+    }
+    if (Recovering(t_us)) return;
+    const motion::VelocityCommand c = controller_.Update(Predict(pose), dt);
+    Send(c.v_m_s, c.w_rad_s, t_us);
+    last_command_ = c;
+    if (controller_.arrived() && (o_.task == Task::kWaypoints || explored_)) Settle(pose, t_us);
+  }
+
+  MissionOptions o_;
+  motion::MotionController controller_;
+  planning::Explorer explorer_;
+  Bus* bus_ = nullptr;
+  TimedPose slam_;
+  bool has_slam_ = false;
+  int64_t first_slam_us_ = -1, last_control_us_ = -1, last_explore_us_ = -1;
+  std::deque<TimedPose> odometry_;
+  std::shared_ptr<const mapping::OccupancyGrid> map_;
+  bool started_ = false;
+  bool explored_ = false;  // the explorer is done; the controller finishes at home
+  std::string state_ = "initializing", detail_;
+  long long commands_ = 0, paths_ = 0, stale_stops_ = 0;
+  int corrections_ = 0, recoveries_ = 0;
+  motion::VelocityCommand last_command_;
+  int64_t stuck_since_us_ = -1, backoff_until_us_ = 0;
+};
+
+}  // namespace
+
+StageType MissionStageType() {
+  return {"mission",
+          "the autonomy after SLAM: follows a circuit of waypoints or explores and returns home (A* + frontiers), "
+          "driving the motion controller; emits velocity commands, paths and states",
+          [](config::Section& s) -> std::unique_ptr<Stage> {
+            MissionOptions o;
+            o.task = s.GetChoice("task", "waypoints", {"waypoints", "explore"},
+                                 "follow a circuit of waypoints, or explore the unknown and return home") == "explore"
+                         ? Task::kExplore
+                         : Task::kWaypoints;
+            const std::vector<std::string> w =
+                s.GetList("waypoints", {"arena"},
+                          "the circuit: 'arena' (the simulated arena's waypoint poses, relative to its start pose) or "
+                          "x, y, theta_deg triples in the start frame");
+            if (!(w.size() == 1 && w[0] == "arena")) {
+              o.waypoints_from_arena = false;
+              if (w.size() % 3 != 0 || w.empty()) s.Fail("waypoints", "expected x, y, theta_deg triples or 'arena'");
+              for (size_t i = 0; i + 2 < w.size(); i += 3) {
+                try {
+                  o.waypoints.push_back({std::stod(w[i]), std::stod(w[i + 1]), std::stod(w[i + 2]) * M_PI / 180.0});
+                } catch (const std::exception&) {
+                  s.Fail("waypoints", "'" + w[i] + ", " + w[i + 1] + ", " + w[i + 2] + "' is not three numbers");
+                }
+              }
+            }
+            auto& c = o.controller;
+            c.kind = s.GetChoice("controller", "rotate_translate_rotate", {"rotate_translate_rotate", "pure_pursuit"},
+                                 "waypoint controller") == "pure_pursuit"
+                         ? motion::ControllerKind::kPurePursuit
+                         : motion::ControllerKind::kRotateTranslateRotate;
+            c.max_speed_m_s = s.GetDouble("max_speed_m_s", c.max_speed_m_s, "speed limit [m/s]", 0.01, 2.0);
+            c.max_turn_rate_rad_s = s.GetDouble("max_turn_rate_rad_s", c.max_turn_rate_rad_s, "turn-rate limit [rad/s]", 0.05, 10.0);
+            c.max_accel_m_s2 = s.GetDouble("max_accel_m_s2", c.max_accel_m_s2, "acceleration limit [m/s^2]", 0.01, 10.0);
+            c.max_angular_accel_rad_s2 = s.GetDouble("max_angular_accel_rad_s2", c.max_angular_accel_rad_s2,
+                                                     "angular acceleration limit [rad/s^2]", 0.1, 100.0);
+            c.final_tolerance_m = s.GetDouble("final_tolerance_m", c.final_tolerance_m, "arrival tolerance at the last waypoint [m]", 0.001, 1.0);
+            c.intermediate_tolerance_m = s.GetDouble("intermediate_tolerance_m", c.intermediate_tolerance_m,
+                                                     "an intermediate waypoint counts as passed this close [m]", 0.001, 2.0);
+            c.final_heading_tolerance_rad = s.GetDouble("final_heading_tolerance_rad", c.final_heading_tolerance_rad,
+                                                        "heading tolerance at the last waypoint [rad]", 0.001, 3.2);
+            c.lookahead_m = s.GetDouble("lookahead_m", c.lookahead_m, "pure pursuit look-ahead [m]", 0.01, 5.0);
+            o.exploration = planning::ParseExplorationOptions(s);
+            o.explore_period_s = s.GetDouble("explore_period_s", o.explore_period_s, "explorer updates at most this often [s]", 0.0, 60.0);
+            o.start_delay_s = s.GetDouble("start_delay_s", o.start_delay_s, "stand still this long after the first SLAM pose [s]", 0.0, 60.0);
+            o.max_pose_age_s = s.GetDouble("max_pose_age_s", o.max_pose_age_s, "stop when the SLAM pose is older than this [s]", 0.01, 60.0);
+            o.control_lag_s = s.GetDouble("control_lag_s", o.control_lag_s,
+                                          "the controller sees the pose predicted this far ahead (the wheels' response lag) [s]", 0.0, 2.0);
+            o.max_corrections = static_cast<int>(s.GetInt("max_corrections", o.max_corrections,
+                                                          "times the final pose is driven to again when the robot stopped outside the tolerances", 0, 100));
+            o.stuck_s = s.GetDouble("stuck_s", o.stuck_s, "commanded to move but stalled this long: back off [s]", 0.1, 60.0);
+            o.backoff_s = s.GetDouble("backoff_s", o.backoff_s, "how long to reverse at 0.1 m/s when stalled [s]", 0.0, 10.0);
+            o.status_channel = s.GetString("status_channel", o.status_channel, "channel of the status events");
+            return std::make_unique<MissionStage>(o);
+          }};
+}
+
+}  // namespace mbot::app

@@ -1,0 +1,123 @@
+// The simulated MBot: a differential-drive robot on a World, with what a real one has between the
+// velocity command and the sensor messages — the Pico firmware's wheel-speed controller (feed-forward
+// through its motor calibration + PID, the Motion issue's WheelSpeedController) running at its own
+// rate, motors that follow their own (different, per wheel) motor model with a time constant, wheel
+// slip, quantised encoders, a gyro with noise and a drifting bias, the firmware's odometry, and an
+// RPLidar-like scanner whose beams are each measured at their own time while the robot moves.
+// Touching a wall with the footprint stops the robot (as a real one would) and is reported.
+//
+// It publishes the events a real robot's log holds, on the same channels, so a simulated run can be
+// recorded and replayed:
+//   MBOT_ENCODERS  kEncoders    cumulative ticks, deltas, dt               (firmware rate)
+//   MBOT_IMU       kImu         gyro z [rad/s] (noise + bias), yaw angle   (imu rate)
+//   MBOT_ODOMETRY  kOdometry    the firmware's dead reckoning (gyrodometry) (firmware rate)
+//   MBOT_MOTOR_PWM kMotorCommand{kPwm}  duties the firmware sent           (firmware rate)
+//   MBOT_MOTOR_VEL kWheelSpeed  wheel speeds the encoders measured [rad/s] (firmware rate)
+//   LIDAR          kLidar       one revolution; angles, per-beam times      (lidar rate)
+//   TRUE_POSE      kGroundTruth the true pose                              (ground-truth rate)
+//   SIM_COLLISION  kCollision   the true pose when a new contact begins
+// Every event has t_us = stamp_us = simulated time. Given the same seed, a run is reproducible.
+// Frames: TRUE_POSE and SIM_COLLISION are in the world frame; MBOT_ODOMETRY starts at (0, 0, 0) like
+// a real robot's. Encoder ticks carry the geometry's encoder polarities (default +1: forward counts
+// up on both wheels); MBOT_MOTOR_VEL wheel speeds are forward-positive. The motors' polarities are
+// those of `motors` / `firmware_calibration` (default +1).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "mbot/drivers/events.hpp"
+#include "mbot/drivers/sim_world.hpp"
+#include "mbot/motion/gyrodometry.hpp"
+#include "mbot/motion/motor_model.hpp"
+#include "mbot/motion/wheel_controller.hpp"
+
+namespace mbot::drivers {
+
+// The channels the simulated robot publishes on.
+namespace sim_channel {
+inline constexpr const char* kEncoders = "MBOT_ENCODERS";
+inline constexpr const char* kImu = "MBOT_IMU";
+inline constexpr const char* kOdometry = "MBOT_ODOMETRY";
+inline constexpr const char* kMotorPwm = "MBOT_MOTOR_PWM";
+inline constexpr const char* kMotorVel = "MBOT_MOTOR_VEL";
+inline constexpr const char* kLidar = "LIDAR";
+inline constexpr const char* kTruePose = "TRUE_POSE";
+inline constexpr const char* kCollision = "SIM_COLLISION";
+}  // namespace sim_channel
+
+struct SimLidarOptions {
+  double rate_hz = 8.0;          // revolutions per second
+  int beams = 360;               // per revolution
+  double max_range_m = 12.0;
+  double min_range_m = 0.15;     // closer returns are dropped, as the RPLidar's
+  double range_noise_m = 0.01;   // standard deviation
+  double dropout = 0.01;         // probability that a beam gives no return
+  motion::Pose2D mount;          // sensor pose on the robot
+  // The RPLidar spins clockwise: beam angles (counter-clockwise convention) go 0, −step, −2·step …
+  // in time, as a real log's decoded angles do. false: 0, +step, … .
+  bool clockwise = true;
+};
+
+struct SimImuOptions {
+  double rate_hz = 50.0;
+  double gyro_noise_rad_s = 0.002;              // white noise per sample, standard deviation
+  double gyro_bias_initial_rad_s = 0.003;       // standard deviation of the bias at start
+  double gyro_bias_walk_rad_s_sqrt_s = 0.0002;  // random walk of the bias
+};
+
+struct SimRobotOptions {
+  motion::RobotGeometry geometry;                // classic MBot; its encoder polarities sign the ticks
+  motion::MotorCalibration motors;               // the true motors (steady-state duty ↔ speed)
+  double left_motor_gain = 1.0;                  // per-wheel differences: true speed scale
+  double right_motor_gain = 0.96;
+  double motor_time_constant_s = 0.05;           // wheel speed follows its steady state with this lag
+  motion::MotorCalibration firmware_calibration; // what the firmware's feed-forward believes
+  motion::WheelControllerOptions controller;     // firmware wheel-speed controller (its dt is the firmware period)
+  motion::GyrodometryOptions firmware_odometry;  // how the firmware fuses its gyro
+  double slip_stddev = 0.02;                     // relative ground-speed noise of each wheel (slip)
+  double slip_interval_s = 0.05;                 // the slip of each wheel is redrawn this often (not white)
+  double physics_dt_s = 0.002;
+  // A contact ends (and the next one counts again) once the footprint grown by this much is clear.
+  double contact_release_m = 0.01;
+  double ground_truth_rate_hz = 100.0;
+  double footprint_radius_m = 0.1;
+  SimLidarOptions lidar;
+  SimImuOptions imu;
+};
+
+class SimRobot {
+ public:
+  // Keeps a reference to `world`, which must outlive the robot. The robot starts at rest at `start`
+  // (world frame) at t = 0. Throws std::invalid_argument when the start pose collides or an option
+  // is out of range.
+  SimRobot(const World& world, const SimRobotOptions& options, const motion::Pose2D& start, uint64_t seed);
+  ~SimRobot();
+
+  // The latest velocity command (MBOT_VEL_CMD): held until the next one.
+  void Command(double v_m_s, double w_rad_s);
+  // Runs the simulation up to `t_us`, appending the events published meanwhile in time order.
+  void AdvanceTo(int64_t t_us, std::vector<Event>* out);
+
+  int64_t now_us() const;
+  const motion::Pose2D& true_pose() const;
+  int collisions() const;   // contacts begun so far
+  bool in_contact() const;
+  double distance_travelled_m() const;
+  // True wheel rotational speeds [rad/s, forward positive] (0 while stalled against a wall).
+  double left_wheel_speed_rad_s() const;
+  double right_wheel_speed_rad_s() const;
+  // True cumulative encoder counts, polarity applied (what the next MBOT_ENCODERS message will carry).
+  int64_t left_ticks() const;
+  int64_t right_ticks() const;
+  double gyro_bias_rad_s() const;
+  const SimRobotOptions& options() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mbot::drivers

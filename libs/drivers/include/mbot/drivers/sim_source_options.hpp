@@ -1,0 +1,29 @@
+// [source] with type = sim: where the simulated robot starts, how long the run lasts, and the
+// simulated robot's options (the keys are read from [source] only when the source is the simulator).
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include "mbot/drivers/sim_robot.hpp"
+#include "mbot/motion/pose2d.hpp"
+
+namespace mbot::config {
+class Section;
+}
+
+namespace mbot::drivers {
+
+struct SimSourceOptions {
+  // World frame. Unset: the world file's `start` pose (an `.arena` file's `pose start …` line);
+  // a grid world has none, so it must be given.
+  std::optional<motion::Pose2D> start;
+  double duration_s = 600.0;  // simulated time after which the stream ends
+  SimRobotOptions robot;
+};
+
+// Reads the simulator's keys of [source]. `world_path` (the source's path) decides whether `start`
+// is required. Throws config::ConfigError naming the key.
+SimSourceOptions ParseSimSourceOptions(config::Section& section, const std::string& world_path);
+
+}  // namespace mbot::drivers

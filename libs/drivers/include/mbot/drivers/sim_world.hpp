@@ -1,0 +1,95 @@
+// The simulator's world: what the walls are, for the simulated lidar (ray casting), the collision
+// check (the robot's footprint against the walls) and the competition's scoring (the true map).
+// Loaded from the project's own arena description (wall segments in metres, `.arena`), a botlab
+// `.map`, a ROS map_server `.yaml` + image or any other map format ReadAnyMap reads; in a grid world
+// every cell that is not known free (occupied or unknown) is a wall, so real arena maps with gaps in
+// their unknown border still enclose the robot.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mbot/mapping/occupancy_grid.hpp"
+#include "mbot/motion/pose2d.hpp"
+
+namespace mbot::drivers {
+
+struct WallSegment {
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // [m]
+};
+
+// The arena file format (`.arena`, text, one statement per line, `#` starts a comment):
+//   name <text>                      a human name for the arena
+//   resolution <m>                   cell size of the true map used for scoring (default 0.025)
+//   thickness <m>                    thickness of the walls that follow (default 0.02; botlab panels)
+//   wall <x0> <y0> <x1> <y1>         a wall segment [m]
+//   box <x0> <y0> <x1> <y1>          the four walls of an axis-aligned rectangle
+//   pose <label> <x> <y> <theta>     a named pose (theta in degrees); labels used by the competition:
+//                                    start, waypoint (in order, the speed-run circuit), target,
+//                                    dropoff (in order, warehouse levels); any label may repeat
+// Errors name the file and the line. Walls are capsules: the segment thickened by thickness/2 on
+// every side, ends rounded (so walls meeting at a corner leave no notch); Raycast, Collides and
+// ClearanceAt all use that one shape. One thickness per arena: a `thickness` statement after the
+// first wall must repeat the value already in force.
+struct ArenaPose {
+  std::string label;
+  motion::Pose2D pose;
+};
+
+struct WorldIndex;
+
+class World {
+ public:
+  World() = default;
+
+  // Reads any world file (see above) by its extension / content. Throws std::runtime_error naming
+  // the file (and line for `.arena`).
+  static World Load(const std::string& path);
+  // Parses an arena description held in a string (`origin` names it in errors, e.g. a file path).
+  static World ParseArena(const std::string& text, const std::string& origin);
+  // A world of wall segments; the true map is rasterised at `resolution_m` with a margin around.
+  static World FromSegments(std::vector<WallSegment> walls, double thickness_m, double resolution_m);
+  // A world whose walls are the grid's cells that are not known free (> 0 or unknown).
+  static World FromGrid(const mapping::OccupancyGrid& grid);
+
+  const std::string& name() const { return name_; }
+  // Distance from (x, y) along `angle_rad` to the first wall surface, or `max_range_m` when no wall
+  // is nearer; 0 when (x, y) is inside a wall. Exact against segments (walls as capsules, see
+  // above) in an arena world, where leaving the true map's extent means no wall; cell-exact (DDA
+  // over the true map, to the first wall cell's boundary) in a grid world, where everything outside
+  // the grid is wall. Thread-safe (no mutable state).
+  double Raycast(double x, double y, double angle_rad, double max_range_m) const;
+  // True when a disc of `radius_m` centred at (x, y) overlaps or touches a wall
+  // (ClearanceAt(x, y) <= radius_m), or leaves the true map's extent.
+  bool Collides(double x, double y, double radius_m) const;
+  // The distance from (x, y) to the nearest wall surface [m] (0 inside a wall). Grid world: exact
+  // distance to the nearest wall cell's square, the outside of the grid counting as wall.
+  double ClearanceAt(double x, double y) const;
+  // The true map: walls +127, everything else -127 (free), at the world's resolution.
+  const mapping::OccupancyGrid& truth() const { return truth_; }
+  // Named poses of an arena file, in file order (empty for grid worlds).
+  const std::vector<ArenaPose>& poses() const { return poses_; }
+  std::vector<motion::Pose2D> PosesLabelled(const std::string& label) const;
+  const std::vector<WallSegment>& walls() const { return walls_; }
+  double wall_thickness() const { return thickness_; }  // 0 for a grid world
+  bool is_grid_world() const { return walls_.empty(); }
+
+ private:
+  std::string name_;
+  std::vector<WallSegment> walls_;  // empty for a grid world
+  double thickness_ = 0.02;
+  std::vector<ArenaPose> poses_;
+  mapping::OccupancyGrid truth_;
+  // Acceleration structures (bucket grid over the walls, or the grid's distance transform), built
+  // once and shared by copies; defined in sim_world.cpp.
+  std::shared_ptr<const WorldIndex> index_;
+};
+
+// The free cells of the true map connected to `start`'s cell (4-connected flood fill over free
+// cells), as a 0/1 mask in the truth's cell order: what "reachable free space" means when an
+// exploration run is scored. Throws when the start is not in a free cell.
+std::vector<uint8_t> ReachableFreeMask(const World& world, const motion::Pose2D& start);
+
+}  // namespace mbot::drivers

@@ -1,0 +1,84 @@
+#include "sim_source.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace mbot::drivers {
+namespace {
+
+motion::Pose2D StartPose(const SourceOptions& options, const World& world) {
+  if (options.sim.start) return *options.sim.start;
+  const std::vector<motion::Pose2D> starts = world.PosesLabelled("start");
+  if (starts.empty()) {
+    throw std::runtime_error(options.path + ": the world has no 'start' pose; set [source] start = x, y, theta_deg");
+  }
+  return starts.front();
+}
+
+std::unique_ptr<SimRobot> MakeRobot(const SourceOptions& options, const World& world, const motion::Pose2D& start) {
+  try {
+    return std::make_unique<SimRobot>(world, options.sim.robot, start, options.seed);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(options.path + ": " + e.what());
+  }
+}
+
+}  // namespace
+
+SimSource::SimSource(const SourceOptions& options)
+    : path_(options.path),
+      seed_(options.seed),
+      duration_us_(static_cast<int64_t>(std::llround(options.sim.duration_s * 1e6))),
+      world_(World::Load(options.path)),
+      start_(StartPose(options, world_)),
+      robot_(MakeRobot(options, world_, start_)) {
+  const std::string gen = "simulated";
+  channels_[sim_channel::kEncoders] = ChannelInfo{"mbot_encoders_t", gen, EventKind::kEncoders, true};
+  channels_[sim_channel::kImu] = ChannelInfo{"mbot_imu_t", gen, EventKind::kImu, true};
+  channels_[sim_channel::kOdometry] = ChannelInfo{"pose2D_t", gen, EventKind::kOdometry, true};
+  channels_[sim_channel::kMotorPwm] = ChannelInfo{"mbot_motor_pwm_t", gen, EventKind::kMotorCommand, true};
+  channels_[sim_channel::kMotorVel] = ChannelInfo{"mbot_motor_vel_t", gen, EventKind::kWheelSpeed, true};
+  channels_[sim_channel::kLidar] = ChannelInfo{"lidar_t", gen, EventKind::kLidar, true};
+  channels_[sim_channel::kTruePose] = ChannelInfo{"pose2D_t", gen, EventKind::kGroundTruth, true};
+  channels_[sim_channel::kCollision] = ChannelInfo{"pose2D_t", gen, EventKind::kCollision, true};
+}
+
+std::optional<Event> SimSource::Next() {
+  while (next_ == buffer_.size()) {
+    buffer_.clear();
+    next_ = 0;
+    const int64_t now = robot_->now_us();
+    if (ended_ || now >= duration_us_) return std::nullopt;
+    const int64_t step = std::max<int64_t>(1, std::llround(robot_->options().physics_dt_s * 1e6));
+    robot_->AdvanceTo(std::min(now + step, duration_us_), &buffer_);
+  }
+  if (ended_) return std::nullopt;
+  return std::move(buffer_[next_++]);
+}
+
+double SimSource::Progress() const {
+  if (ended_ || duration_us_ <= 0) return 1.0;
+  return std::min(1.0, double(robot_->now_us()) / double(duration_us_));
+}
+
+std::vector<std::pair<std::string, std::string>> SimSource::Details() const {
+  std::ostringstream start, duration;
+  start << start_.x << ", " << start_.y << ", " << start_.theta * 180.0 / M_PI << " deg";
+  duration << duration_us_ * 1e-6 << " s";
+  return {{"world", world_.name().empty() ? path_ : world_.name()},
+          {"world file", path_},
+          {"start", start.str()},
+          {"seed", std::to_string(seed_)},
+          {"duration", duration.str()},
+          {"collisions", std::to_string(robot_->collisions())}};
+}
+
+void SimSource::Send(const Event& event) {
+  if (event.kind != EventKind::kMotorCommand) return;
+  const auto* cmd = std::get_if<MotorCommand>(&event.payload);
+  if (cmd && cmd->kind == MotorCommand::Kind::kVelocity) robot_->Command(cmd->a, cmd->b);
+}
+
+}  // namespace mbot::drivers

@@ -1,0 +1,60 @@
+// The simulator as a source and a sink: a SimRobot on a World, stepped in simulated time as events
+// are asked for, driven by the velocity commands sent back to it. Time comes from the simulation, so
+// a run goes as fast as the pipeline consumes it.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "mbot/drivers/sim_robot.hpp"
+#include "mbot/drivers/sim_world.hpp"
+#include "mbot/drivers/sink.hpp"
+#include "mbot/drivers/source.hpp"
+#include "mbot/drivers/source_options.hpp"
+
+namespace mbot::drivers {
+
+class SimSource : public Source, public Sink {
+ public:
+  // Loads options.path as the world (World::Load) and places the robot at options.sim.start, or at
+  // the world's `start` pose. Throws std::runtime_error naming the path (and [source] start when the
+  // world has no start pose) or std::invalid_argument when the start collides.
+  explicit SimSource(const SourceOptions& options);
+  SimSource(const SimSource&) = delete;  // the robot holds a reference to world_
+  SimSource& operator=(const SimSource&) = delete;
+
+  // The robot's events in time order. The robot is simulated one physics step at a time, only as
+  // far as needed to produce the next event, so a command sent in reaction to an event takes effect
+  // at (at most one physics step after) that event's time. nullopt at duration_s or after RequestEnd().
+  std::optional<Event> Next() override;
+  // Simulated time / duration.
+  double Progress() const override;
+  std::string Format() const override { return "simulator"; }
+  std::vector<std::pair<std::string, std::string>> Details() const override;
+
+  // A kMotorCommand of Kind::kVelocity becomes the robot's command (held until the next one); every
+  // other event is ignored.
+  void Send(const Event& event) override;
+  // Ends the stream: the next Next() returns nullopt (events simulated but not yet returned are dropped).
+  void RequestEnd() { ended_ = true; }
+
+  const SimRobot& robot() const { return *robot_; }
+  const World& world() const { return world_; }
+  const motion::Pose2D& start() const { return start_; }
+
+ private:
+  std::string path_;
+  uint64_t seed_;
+  int64_t duration_us_;
+  World world_;
+  motion::Pose2D start_;
+  std::unique_ptr<SimRobot> robot_;
+  std::vector<Event> buffer_;
+  size_t next_ = 0;
+  bool ended_ = false;
+};
+
+}  // namespace mbot::drivers

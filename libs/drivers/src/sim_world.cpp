@@ -1,0 +1,597 @@
+#include "mbot/drivers/sim_world.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "mbot/common/strings.hpp"
+#include "mbot/drivers/map_io.hpp"
+
+namespace mbot::drivers {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kPi = 3.14159265358979323846;
+// Ranges accepted for an arena's true-map resolution and wall thickness [m].
+constexpr double kMinResolution = 0.005, kMaxResolution = 0.5;
+constexpr double kMinThickness = 0.001, kMaxThickness = 1.0;
+// Free cells kept around the walls' (thickened) bounding box in the true map.
+constexpr int kMarginCells = 4;
+// Largest true map side [cells]: a typo in a coordinate should fail, not allocate gigabytes.
+constexpr double kMaxCellsPerSide = 20000;
+// Bucket side of the arena acceleration grid [m]. On maze_3 (16 walls, mean ray 0.7 m), 0.45–1.0 m
+// buckets all cast about 4.5–5 M rays/s, 0.15 m ones 2.9 M, one bucket for everything 2.6 M.
+constexpr double kBucketSize = 0.5;
+
+std::string Num(double v) {
+  char buf[32];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+// A wall as the ray caster sees it: start point, unit direction and length.
+struct Capsule {
+  double ax, ay, ux, uy, len;
+};
+
+// Distance along the unit ray (ox, oy) + s (dx, dy) to the surface of the capsule of radius h
+// around the segment; 0 when the origin is inside (or on) it; +inf when the ray misses.
+inline double RayCapsule(const Capsule& c, double h, double ox, double oy, double dx, double dy) {
+  const double wx = ox - c.ax, wy = oy - c.ay;
+  const double ou = wx * c.ux + wy * c.uy;   // along the segment
+  const double ov = -wx * c.uy + wy * c.ux;  // across it
+  const double eu = ou - std::clamp(ou, 0.0, c.len);
+  if (eu * eu + ov * ov <= h * h) return 0.0;
+  const double du = dx * c.ux + dy * c.uy;
+  const double dv = -dx * c.uy + dy * c.ux;
+  const double aov = std::abs(ov);
+  if (aov > h && ov * dv < 0.0) {
+    // Entering the slab |v| <= h: everything before is outside the capsule, so a side-face hit
+    // within the segment's length is the first entry.
+    const double s = (aov - h) / std::abs(dv);
+    const double u = ou + s * du;
+    if (u >= 0.0 && u <= c.len) return s;
+  }
+  // Otherwise the ray can only enter through an end disc (the origin is outside both).
+  double best = kInf;
+  for (const double cu : {0.0, c.len}) {
+    const double pu = ou - cu;
+    const double b = pu * du + ov * dv;
+    if (b >= 0.0) continue;  // moving away from this end
+    const double disc = b * b - (pu * pu + ov * ov - h * h);
+    if (disc < 0.0) continue;
+    best = std::min(best, -b - std::sqrt(disc));
+  }
+  return best;
+}
+
+// Squared distance from (px, py) to the capsule's centre segment.
+inline double SegmentDist2(const Capsule& c, double px, double py) {
+  const double wx = px - c.ax, wy = py - c.ay;
+  const double ou = wx * c.ux + wy * c.uy;
+  const double ov = -wx * c.uy + wy * c.ux;
+  const double eu = ou - std::clamp(ou, 0.0, c.len);
+  return eu * eu + ov * ov;
+}
+
+}  // namespace
+
+struct WorldIndex {
+  // Arena world: walls as capsules of radius h, and a uniform bucket grid over the true map's
+  // extent listing, per bucket, the walls whose thickened bounding box overlaps it (CSR layout).
+  std::vector<Capsule> capsules;
+  double h = 0;
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // extent of the true map = of the bucket grid
+  double bucket = kBucketSize;
+  int nbx = 0, nby = 0;
+  std::vector<int> bucket_start;  // nbx * nby + 1 offsets into bucket_items
+  std::vector<int> bucket_items;
+
+  // Grid world: the Euclidean distance from each cell's centre to the nearest wall cell's centre
+  // [cells] (a lower bound that lets ClearanceAt skip the empty rings around a point).
+  std::vector<float> centre_distance;
+  bool any_wall_cell = false;
+
+  int BucketIndex(int bx, int by) const { return by * nbx + bx; }
+};
+
+namespace {
+
+// Arena-world ray cast: Amanatides–Woo traversal of the bucket grid, testing each bucket's walls;
+// stops once the nearest hit lies before the current bucket's exit.
+double RaycastArena(const WorldIndex& ix, double x, double y, double angle, double max_range) {
+  const double dx = std::cos(angle), dy = std::sin(angle);
+  // Clip the ray to the grid's box; outside it there are no walls.
+  double t0 = 0.0, t1 = max_range;
+  auto clip = [&](double o, double d, double lo, double hi) {
+    if (d == 0.0) return o >= lo && o <= hi;
+    double a = (lo - o) / d, b = (hi - o) / d;
+    if (a > b) std::swap(a, b);
+    t0 = std::max(t0, a);
+    t1 = std::min(t1, b);
+    return t0 <= t1;
+  };
+  if (!(max_range > 0.0) || !clip(x, dx, ix.x0, ix.x1) || !clip(y, dy, ix.y0, ix.y1)) {
+    return std::max(max_range, 0.0);
+  }
+  const double px = x + t0 * dx, py = y + t0 * dy;
+  int bx = std::clamp(static_cast<int>(std::floor((px - ix.x0) / ix.bucket)), 0, ix.nbx - 1);
+  int by = std::clamp(static_cast<int>(std::floor((py - ix.y0) / ix.bucket)), 0, ix.nby - 1);
+  const int step_x = dx > 0 ? 1 : -1, step_y = dy > 0 ? 1 : -1;
+  const double inv_dx = dx != 0.0 ? 1.0 / dx : kInf, inv_dy = dy != 0.0 ? 1.0 / dy : kInf;
+  auto next_x = [&] { return dx != 0.0 ? (ix.x0 + (bx + (dx > 0)) * ix.bucket - x) * inv_dx : kInf; };
+  auto next_y = [&] { return dy != 0.0 ? (ix.y0 + (by + (dy > 0)) * ix.bucket - y) * inv_dy : kInf; };
+  double t_max_x = next_x(), t_max_y = next_y();
+  double best = max_range;
+  for (;;) {
+    const int b = ix.BucketIndex(bx, by);
+    for (int k = ix.bucket_start[b]; k < ix.bucket_start[b + 1]; ++k) {
+      const double s = RayCapsule(ix.capsules[ix.bucket_items[k]], ix.h, x, y, dx, dy);
+      if (s < best) best = s;
+    }
+    const double t_exit = std::min(t_max_x, t_max_y);
+    if (best <= t_exit || t_exit >= t1) return best;
+    if (t_max_x < t_max_y) {
+      bx += step_x;
+      if (bx < 0 || bx >= ix.nbx) return best;
+      t_max_x = next_x();
+    } else {
+      by += step_y;
+      if (by < 0 || by >= ix.nby) return best;
+      t_max_y = next_y();
+    }
+  }
+}
+
+// Grid-world ray cast: Amanatides–Woo over the true map's cells to the first wall cell's boundary;
+// outside the grid is wall.
+double RaycastGrid(const mapping::OccupancyGrid& g, double x, double y, double angle, double max_range) {
+  int cx, cy;
+  g.WorldToCell(x, y, &cx, &cy);
+  if (!g.IsInside(cx, cy) || g.at(cx, cy) > 0 || !(max_range > 0.0)) return 0.0;
+  const double dx = std::cos(angle), dy = std::sin(angle);
+  const double res = g.resolution(), ox = g.origin_x(), oy = g.origin_y();
+  const int step_x = dx > 0 ? 1 : -1, step_y = dy > 0 ? 1 : -1;
+  const double inv_dx = dx != 0.0 ? 1.0 / dx : kInf, inv_dy = dy != 0.0 ? 1.0 / dy : kInf;
+  auto next_x = [&] { return dx != 0.0 ? (ox + (cx + (dx > 0)) * res - x) * inv_dx : kInf; };
+  auto next_y = [&] { return dy != 0.0 ? (oy + (cy + (dy > 0)) * res - y) * inv_dy : kInf; };
+  double t_max_x = next_x(), t_max_y = next_y();
+  for (;;) {
+    double t;
+    if (t_max_x < t_max_y) {
+      t = t_max_x;
+      cx += step_x;
+      t_max_x = next_x();
+    } else {
+      t = t_max_y;
+      cy += step_y;
+      t_max_y = next_y();
+    }
+    if (t >= max_range) return max_range;
+    if (!g.IsInside(cx, cy) || g.at(cx, cy) > 0) return std::max(t, 0.0);
+  }
+}
+
+// Arena world: distance from (x, y) to the nearest wall's centre segment, searching the buckets in
+// growing square rings until no unvisited bucket can hold anything nearer.
+double NearestSegmentDistance(const WorldIndex& ix, double x, double y) {
+  double best2 = kInf;
+  const int bx = static_cast<int>(std::floor((x - ix.x0) / ix.bucket));
+  const int by = static_cast<int>(std::floor((y - ix.y0) / ix.bucket));
+  if (bx < 0 || by < 0 || bx >= ix.nbx || by >= ix.nby) {
+    for (const auto& c : ix.capsules) best2 = std::min(best2, SegmentDist2(c, x, y));
+    return std::sqrt(best2);
+  }
+  const int max_ring = std::max({bx, by, ix.nbx - 1 - bx, ix.nby - 1 - by});
+  for (int k = 0; k <= max_ring; ++k) {
+    for (int j = by - k; j <= by + k; ++j) {
+      if (j < 0 || j >= ix.nby) continue;
+      const bool edge_row = j == by - k || j == by + k;
+      for (int i = bx - k; i <= bx + k; i += edge_row ? 1 : 2 * k) {
+        if (i >= 0 && i < ix.nbx) {
+          const int b = ix.BucketIndex(i, j);
+          for (int q = ix.bucket_start[b]; q < ix.bucket_start[b + 1]; ++q) {
+            best2 = std::min(best2, SegmentDist2(ix.capsules[ix.bucket_items[q]], x, y));
+          }
+        }
+        if (k == 0) break;
+      }
+    }
+    // Anything not yet visited lies outside the block of rings 0..k.
+    const double reach = std::min({x - (ix.x0 + (bx - k) * ix.bucket), ix.x0 + (bx + k + 1) * ix.bucket - x,
+                                   y - (ix.y0 + (by - k) * ix.bucket), ix.y0 + (by + k + 1) * ix.bucket - y});
+    if (best2 <= reach * reach) break;
+  }
+  return std::sqrt(best2);
+}
+
+// Grid world: exact distance from (x, y) (inside the grid, in a free cell) to the nearest wall
+// cell's square or to the grid's outside, searching cells in square rings; rings nearer than the
+// distance transform allows are skipped.
+double GridClearance(const mapping::OccupancyGrid& g, const WorldIndex& ix, double x, double y) {
+  const double res = g.resolution();
+  const double gx0 = g.origin_x(), gy0 = g.origin_y();
+  double best = std::min({x - gx0, gx0 + g.width() * res - x, y - gy0, gy0 + g.height() * res - y});
+  if (!ix.any_wall_cell) return best;
+  int cx, cy;
+  g.WorldToCell(x, y, &cx, &cy);
+  const double d_centres = ix.centre_distance[static_cast<size_t>(cy) * g.width() + cx];
+  // A wall cell k rings away has its centre within k·√2 cells, so rings below D/√2 are empty.
+  const int k_first = std::max(0, static_cast<int>(std::floor(d_centres / std::sqrt(2.0) - 1e-3)));
+  const int max_ring = std::max({cx, cy, g.width() - 1 - cx, g.height() - 1 - cy});
+  for (int k = k_first; k <= max_ring; ++k) {
+    // Anything in ring k is at least this far: the gap to the inner block's boundary.
+    const double ring_floor = k == 0 ? 0.0
+                                     : std::min({x - (gx0 + (cx - k + 1) * res), gx0 + (cx + k) * res - x,
+                                                 y - (gy0 + (cy - k + 1) * res), gy0 + (cy + k) * res - y});
+    if (ring_floor >= best) break;
+    for (int j = cy - k; j <= cy + k; ++j) {
+      if (j < 0 || j >= g.height()) continue;
+      const bool edge_row = j == cy - k || j == cy + k;
+      const double ddy = std::max(0.0, std::abs(y - (gy0 + (j + 0.5) * res)) - 0.5 * res);
+      for (int i = cx - k; i <= cx + k; i += edge_row ? 1 : 2 * k) {
+        if (i >= 0 && i < g.width() && g.at(i, j) > 0) {
+          const double ddx = std::max(0.0, std::abs(x - (gx0 + (i + 0.5) * res)) - 0.5 * res);
+          best = std::min(best, std::hypot(ddx, ddy));
+        }
+        if (k == 0) break;
+      }
+    }
+  }
+  return best;
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot open");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+bool HasArenaExtension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".arena";
+}
+
+}  // namespace
+
+World World::Load(const std::string& path) {
+  World w;
+  if (HasArenaExtension(path)) {
+    w = ParseArena(ReadText(path), path);
+  } else {
+    const mapping::OccupancyGrid grid = ReadAnyMap(path);  // names the file itself
+    try {
+      w = FromGrid(grid);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(path + ": " + e.what());
+    }
+  }
+  if (w.name_.empty()) w.name_ = fs::path(path).stem().string();
+  return w;
+}
+
+World World::ParseArena(const std::string& text, const std::string& origin) {
+  std::vector<WallSegment> walls;
+  std::vector<ArenaPose> poses;
+  std::string name;
+  double thickness = 0.02, resolution = 0.025;
+  int name_line = 0, resolution_line = 0, first_wall_line = 0;
+
+  std::istringstream in(text);
+  std::string raw;
+  int line_no = 0;
+  auto fail = [&](const std::string& why) -> void {
+    throw std::runtime_error(origin + ":" + std::to_string(line_no) + ": " + why);
+  };
+  auto number = [&](const std::string& stmt, const std::string& tok) {
+    double v = 0;
+    const auto r = std::from_chars(tok.data(), tok.data() + tok.size(), v);
+    if (r.ptr != tok.data() + tok.size() || (r.ec != std::errc() && r.ec != std::errc::result_out_of_range)) {
+      fail("'" + stmt + "': '" + tok + "' is not a number");
+    }
+    if (r.ec != std::errc() || !std::isfinite(v)) fail("'" + stmt + "': '" + tok + "' is not a finite number");
+    return v;
+  };
+  while (std::getline(in, raw)) {
+    ++line_no;
+    const auto hash = raw.find('#');
+    const std::string line = Trim(hash == std::string::npos ? raw : raw.substr(0, hash));
+    if (line.empty()) continue;
+    std::istringstream ls(line);
+    std::string stmt, tok;
+    ls >> stmt;
+    std::vector<std::string> args;
+    while (ls >> tok) args.push_back(tok);
+    auto need = [&](size_t n, const std::string& what) {
+      if (args.size() != n) fail("'" + stmt + "' needs " + what + ", got " + std::to_string(args.size()));
+    };
+
+    if (stmt == "name") {
+      if (name_line) fail("'name' given twice (first at line " + std::to_string(name_line) + ")");
+      name = Trim(line.substr(4));
+      if (name.empty()) fail("'name' needs a text");
+      name_line = line_no;
+    } else if (stmt == "resolution") {
+      if (resolution_line) fail("'resolution' given twice (first at line " + std::to_string(resolution_line) + ")");
+      need(1, "1 number");
+      resolution = number(stmt, args[0]);
+      if (resolution < kMinResolution || resolution > kMaxResolution) {
+        fail("'resolution' " + args[0] + " out of range [" + Num(kMinResolution) + ", " + Num(kMaxResolution) + "] m");
+      }
+      resolution_line = line_no;
+    } else if (stmt == "thickness") {
+      need(1, "1 number");
+      const double t = number(stmt, args[0]);
+      if (t < kMinThickness || t > kMaxThickness) {
+        fail("'thickness' " + args[0] + " out of range [" + Num(kMinThickness) + ", " + Num(kMaxThickness) + "] m");
+      }
+      if (first_wall_line && t != thickness) {
+        fail("'thickness' " + args[0] + " differs from the " + Num(thickness) + " m of the walls before (line " +
+             std::to_string(first_wall_line) + "); an arena has one wall thickness");
+      }
+      thickness = t;
+    } else if (stmt == "wall" || stmt == "box") {
+      need(4, "4 numbers");
+      double v[4];
+      for (int i = 0; i < 4; ++i) v[i] = number(stmt, args[i]);
+      if (stmt == "wall") {
+        if (v[0] == v[2] && v[1] == v[3]) fail("'wall' has zero length");
+        walls.push_back({v[0], v[1], v[2], v[3]});
+      } else {
+        if (v[0] == v[2] || v[1] == v[3]) fail("'box' has zero width or height");
+        const double xa = std::min(v[0], v[2]), xb = std::max(v[0], v[2]);
+        const double ya = std::min(v[1], v[3]), yb = std::max(v[1], v[3]);
+        walls.push_back({xa, ya, xb, ya});
+        walls.push_back({xb, ya, xb, yb});
+        walls.push_back({xb, yb, xa, yb});
+        walls.push_back({xa, yb, xa, ya});
+      }
+      if (!first_wall_line) first_wall_line = line_no;
+    } else if (stmt == "pose") {
+      need(4, "<label> <x> <y> <theta_deg> (4 values)");
+      ArenaPose p;
+      p.label = args[0];
+      p.pose.x = number(stmt, args[1]);
+      p.pose.y = number(stmt, args[2]);
+      p.pose.theta = motion::WrapAngle(number(stmt, args[3]) * kPi / 180.0);
+      poses.push_back(p);
+    } else {
+      fail("unknown statement '" + stmt + "' (known: name, resolution, thickness, wall, box, pose)");
+    }
+  }
+  if (walls.empty()) throw std::runtime_error(origin + ": no walls (an arena needs at least one 'wall' or 'box')");
+  World w;
+  try {
+    w = FromSegments(std::move(walls), thickness, resolution);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(origin + ": " + e.what());
+  }
+  w.name_ = name.empty() ? fs::path(origin).stem().string() : name;
+  w.poses_ = std::move(poses);
+  return w;
+}
+
+World World::FromSegments(std::vector<WallSegment> walls, double thickness_m, double resolution_m) {
+  if (walls.empty()) throw std::runtime_error("a world of segments needs at least one wall");
+  if (!(thickness_m >= kMinThickness && thickness_m <= kMaxThickness)) {
+    throw std::runtime_error("wall thickness " + Num(thickness_m) + " m out of range [" + Num(kMinThickness) + ", " +
+                             Num(kMaxThickness) + "]");
+  }
+  if (!(resolution_m >= kMinResolution && resolution_m <= kMaxResolution)) {
+    throw std::runtime_error("resolution " + Num(resolution_m) + " m out of range [" + Num(kMinResolution) + ", " +
+                             Num(kMaxResolution) + "]");
+  }
+  auto index = std::make_shared<WorldIndex>();
+  const double h = 0.5 * thickness_m;
+  index->h = h;
+  double min_x = kInf, min_y = kInf, max_x = -kInf, max_y = -kInf;
+  for (size_t i = 0; i < walls.size(); ++i) {
+    const auto& s = walls[i];
+    if (!std::isfinite(s.x0) || !std::isfinite(s.y0) || !std::isfinite(s.x1) || !std::isfinite(s.y1)) {
+      throw std::runtime_error("wall " + std::to_string(i) + " has a non-finite coordinate");
+    }
+    const double len = std::hypot(s.x1 - s.x0, s.y1 - s.y0);
+    if (!(len > 0.0)) throw std::runtime_error("wall " + std::to_string(i) + " has zero length");
+    index->capsules.push_back({s.x0, s.y0, (s.x1 - s.x0) / len, (s.y1 - s.y0) / len, len});
+    min_x = std::min({min_x, s.x0, s.x1});
+    max_x = std::max({max_x, s.x0, s.x1});
+    min_y = std::min({min_y, s.y0, s.y1});
+    max_y = std::max({max_y, s.y0, s.y1});
+  }
+  const double res = resolution_m;
+  const double cells_x = (max_x - min_x + 2 * h) / res + 2 * kMarginCells + 2;
+  const double cells_y = (max_y - min_y + 2 * h) / res + 2 * kMarginCells + 2;
+  if (cells_x > kMaxCellsPerSide || cells_y > kMaxCellsPerSide) {
+    throw std::runtime_error("the walls span " + Num(max_x - min_x) + " x " + Num(max_y - min_y) +
+                             " m, too large for a true map at " + Num(res) + " m");
+  }
+  // True map: cell-aligned to multiples of the resolution, a margin of free cells around.
+  const int gx0 = static_cast<int>(std::floor((min_x - h) / res)) - kMarginCells;
+  const int gy0 = static_cast<int>(std::floor((min_y - h) / res)) - kMarginCells;
+  const int gx1 = static_cast<int>(std::ceil((max_x + h) / res)) + kMarginCells;
+  const int gy1 = static_cast<int>(std::ceil((max_y + h) / res)) + kMarginCells;
+  World w;
+  w.truth_ = mapping::OccupancyGrid(gx1 - gx0, gy1 - gy0, res, gx0 * res, gy0 * res, -127);
+  auto& g = w.truth_;
+  const double reach = h + 0.5 * res;  // cell centres this near a segment are wall: no gaps
+  for (const auto& c : index->capsules) {
+    const double bx0 = std::min(c.ax, c.ax + c.ux * c.len) - reach, bx1 = std::max(c.ax, c.ax + c.ux * c.len) + reach;
+    const double by0 = std::min(c.ay, c.ay + c.uy * c.len) - reach, by1 = std::max(c.ay, c.ay + c.uy * c.len) + reach;
+    int i0, j0, i1, j1;
+    g.WorldToCell(bx0, by0, &i0, &j0);
+    g.WorldToCell(bx1, by1, &i1, &j1);
+    for (int j = std::max(j0, 0); j <= std::min(j1, g.height() - 1); ++j) {
+      for (int i = std::max(i0, 0); i <= std::min(i1, g.width() - 1); ++i) {
+        double cx, cy;
+        g.CellToWorld(i, j, &cx, &cy);
+        if (SegmentDist2(c, cx, cy) <= reach * reach) g.at(i, j) = 127;
+      }
+    }
+  }
+  // Bucket grid over the true map's extent.
+  index->x0 = g.origin_x();
+  index->y0 = g.origin_y();
+  index->x1 = g.origin_x() + g.width() * res;
+  index->y1 = g.origin_y() + g.height() * res;
+  index->bucket = std::max({kBucketSize, (index->x1 - index->x0) / 1024, (index->y1 - index->y0) / 1024});
+  index->nbx = std::max(1, static_cast<int>(std::ceil((index->x1 - index->x0) / index->bucket)));
+  index->nby = std::max(1, static_cast<int>(std::ceil((index->y1 - index->y0) / index->bucket)));
+  std::vector<std::vector<int>> lists(static_cast<size_t>(index->nbx) * index->nby);
+  for (size_t k = 0; k < index->capsules.size(); ++k) {
+    const auto& c = index->capsules[k];
+    const double ex = c.ax + c.ux * c.len, ey = c.ay + c.uy * c.len;
+    auto bucket_of = [&](double v, double o, int n) {
+      return std::clamp(static_cast<int>(std::floor((v - o) / index->bucket)), 0, n - 1);
+    };
+    const int i0 = bucket_of(std::min(c.ax, ex) - h, index->x0, index->nbx);
+    const int i1 = bucket_of(std::max(c.ax, ex) + h, index->x0, index->nbx);
+    const int j0 = bucket_of(std::min(c.ay, ey) - h, index->y0, index->nby);
+    const int j1 = bucket_of(std::max(c.ay, ey) + h, index->y0, index->nby);
+    for (int j = j0; j <= j1; ++j) {
+      for (int i = i0; i <= i1; ++i) {
+        // Keep only buckets the capsule really reaches (a diagonal wall's box holds many it does not).
+        const double cx = index->x0 + (i + 0.5) * index->bucket, cy = index->y0 + (j + 0.5) * index->bucket;
+        const double r = h + index->bucket * std::sqrt(0.5);
+        if (SegmentDist2(c, cx, cy) <= r * r) lists[index->BucketIndex(i, j)].push_back(static_cast<int>(k));
+      }
+    }
+  }
+  index->bucket_start.assign(lists.size() + 1, 0);
+  for (size_t b = 0; b < lists.size(); ++b) {
+    index->bucket_start[b + 1] = index->bucket_start[b] + static_cast<int>(lists[b].size());
+    index->bucket_items.insert(index->bucket_items.end(), lists[b].begin(), lists[b].end());
+  }
+  w.walls_ = std::move(walls);
+  w.thickness_ = thickness_m;
+  w.index_ = std::move(index);
+  return w;
+}
+
+World World::FromGrid(const mapping::OccupancyGrid& grid) {
+  if (grid.width() <= 0 || grid.height() <= 0) throw std::runtime_error("a grid world needs a non-empty grid");
+  World w;
+  w.thickness_ = 0.0;
+  w.truth_ = mapping::OccupancyGrid(grid.width(), grid.height(), grid.resolution(), grid.origin_x(), grid.origin_y());
+  auto index = std::make_shared<WorldIndex>();
+  cv::Mat free_mask(grid.height(), grid.width(), CV_8U);
+  for (int j = 0; j < grid.height(); ++j) {
+    for (int i = 0; i < grid.width(); ++i) {
+      const bool wall = grid.at(i, j) >= 0;  // occupied or unknown
+      w.truth_.at(i, j) = wall ? 127 : -127;
+      free_mask.at<uint8_t>(j, i) = wall ? 0 : 255;
+      index->any_wall_cell |= wall;
+    }
+  }
+  if (index->any_wall_cell) {
+    cv::Mat dist;
+    cv::distanceTransform(free_mask, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+    index->centre_distance.assign(static_cast<size_t>(grid.width()) * grid.height(), 0.0f);
+    for (int j = 0; j < grid.height(); ++j) {
+      const float* row = dist.ptr<float>(j);
+      std::copy(row, row + grid.width(), index->centre_distance.begin() + static_cast<size_t>(j) * grid.width());
+    }
+  }
+  w.index_ = std::move(index);
+  return w;
+}
+
+double World::Raycast(double x, double y, double angle_rad, double max_range_m) const {
+  if (!index_ || !std::isfinite(x) || !std::isfinite(y)) return 0.0;
+  if (!is_grid_world()) return RaycastArena(*index_, x, y, angle_rad, max_range_m);
+  return RaycastGrid(truth_, x, y, angle_rad, max_range_m);
+}
+
+double World::ClearanceAt(double x, double y) const {
+  if (!index_ || !std::isfinite(x) || !std::isfinite(y)) return 0.0;
+  if (!is_grid_world()) return std::max(0.0, NearestSegmentDistance(*index_, x, y) - index_->h);
+  int cx, cy;
+  truth_.WorldToCell(x, y, &cx, &cy);
+  if (!truth_.IsInside(cx, cy) || truth_.at(cx, cy) > 0) return 0.0;
+  return GridClearance(truth_, *index_, x, y);
+}
+
+bool World::Collides(double x, double y, double radius_m) const {
+  if (!index_) return true;
+  const double r = std::max(radius_m, 0.0);
+  const double x0 = truth_.origin_x(), y0 = truth_.origin_y();
+  const double x1 = x0 + truth_.width() * truth_.resolution(), y1 = y0 + truth_.height() * truth_.resolution();
+  if (!(x - r >= x0 && x + r < x1 && y - r >= y0 && y + r < y1)) return true;  // leaves the world (or NaN)
+  if (is_grid_world()) {
+    int cx, cy;
+    truth_.WorldToCell(x, y, &cx, &cy);
+    if (truth_.at(cx, cy) > 0) return true;
+    if (index_->any_wall_cell) {
+      // Quick reject: the distance transform bounds the clearance from below by D − √2 cells.
+      const double lower = (index_->centre_distance[static_cast<size_t>(cy) * truth_.width() + cx] - std::sqrt(2.0) - 1e-3) *
+                           truth_.resolution();
+      if (lower > r) return false;
+    }
+    return GridClearance(truth_, *index_, x, y) <= r;
+  }
+  // Arena world: the walls in the buckets the disc's box touches.
+  const WorldIndex& ix = *index_;
+  const double reach = r + ix.h;
+  const int i0 = std::clamp(static_cast<int>(std::floor((x - r - ix.x0) / ix.bucket)), 0, ix.nbx - 1);
+  const int i1 = std::clamp(static_cast<int>(std::floor((x + r - ix.x0) / ix.bucket)), 0, ix.nbx - 1);
+  const int j0 = std::clamp(static_cast<int>(std::floor((y - r - ix.y0) / ix.bucket)), 0, ix.nby - 1);
+  const int j1 = std::clamp(static_cast<int>(std::floor((y + r - ix.y0) / ix.bucket)), 0, ix.nby - 1);
+  for (int j = j0; j <= j1; ++j) {
+    for (int i = i0; i <= i1; ++i) {
+      const int b = ix.BucketIndex(i, j);
+      for (int k = ix.bucket_start[b]; k < ix.bucket_start[b + 1]; ++k) {
+        if (SegmentDist2(ix.capsules[ix.bucket_items[k]], x, y) <= reach * reach) return true;
+      }
+    }
+  }
+  return false;
+}
+
+std::vector<motion::Pose2D> World::PosesLabelled(const std::string& label) const {
+  std::vector<motion::Pose2D> out;
+  for (const auto& p : poses_) {
+    if (p.label == label) out.push_back(p.pose);
+  }
+  return out;
+}
+
+std::vector<uint8_t> ReachableFreeMask(const World& world, const motion::Pose2D& start) {
+  const auto& g = world.truth();
+  int sx, sy;
+  g.WorldToCell(start.x, start.y, &sx, &sy);
+  if (!g.IsInside(sx, sy) || g.at(sx, sy) >= 0) {
+    throw std::runtime_error("ReachableFreeMask: start (" + Num(start.x) + ", " + Num(start.y) +
+                             ") is not in a free cell of the true map of '" + world.name() + "'");
+  }
+  std::vector<uint8_t> mask(g.cells().size(), 0);
+  std::vector<int> stack{sy * g.width() + sx};
+  mask[stack.back()] = 1;
+  while (!stack.empty()) {
+    const int c = stack.back();
+    stack.pop_back();
+    const int cx = c % g.width(), cy = c / g.width();
+    const int nx[4] = {cx + 1, cx - 1, cx, cx};
+    const int ny[4] = {cy, cy, cy + 1, cy - 1};
+    for (int k = 0; k < 4; ++k) {
+      if (!g.IsInside(nx[k], ny[k])) continue;
+      const int n = ny[k] * g.width() + nx[k];
+      if (!mask[n] && g.cells()[n] < 0) {
+        mask[n] = 1;
+        stack.push_back(n);
+      }
+    }
+  }
+  return mask;
+}
+
+}  // namespace mbot::drivers

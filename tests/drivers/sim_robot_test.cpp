@@ -1,0 +1,439 @@
+#include "mbot/drivers/sim_robot.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <type_traits>
+#include <variant>
+
+#include "mbot/common/config.hpp"
+#include "mbot/drivers/source_options.hpp"
+#include "sim_source.hpp"
+#include "test_util.hpp"
+
+namespace mbot::drivers {
+namespace {
+
+using motion::Pose2D;
+
+constexpr int64_t kSecond = 1000000;
+
+World Box(double half) {
+  std::ostringstream a;
+  a << "name box\nbox " << -half << " " << -half << " " << half << " " << half << "\n";
+  return World::ParseArena(a.str(), "box.arena");
+}
+
+std::vector<Event> Drive(SimRobot& robot, double v, double w, double until_s) {
+  std::vector<Event> out;
+  robot.Command(v, w);
+  robot.AdvanceTo(static_cast<int64_t>(until_s * kSecond), &out);
+  return out;
+}
+
+std::vector<Event> OfKind(const std::vector<Event>& events, EventKind kind) {
+  std::vector<Event> out;
+  for (const auto& e : events) {
+    if (e.kind == kind) out.push_back(e);
+  }
+  return out;
+}
+
+const Pose2D& PoseOf(const Event& e) { return std::get<Pose2D>(e.payload); }
+
+// The ground-truth pose at t_us (the series holds one every 10 ms).
+Pose2D TruthAt(const std::vector<Event>& events, int64_t t_us) {
+  std::vector<motion::TimedPose> series;
+  for (const auto& e : OfKind(events, EventKind::kGroundTruth)) series.push_back({e.t_us, PoseOf(e)});
+  Pose2D p;
+  EXPECT_TRUE(motion::InterpolateAt(series, t_us, 20000, &p)) << t_us;
+  return p;
+}
+
+TEST(SimRobot, DrivesStraightAtTheCommandedSpeed) {
+  const World world = Box(3.0);
+  const Pose2D start{-1.5, 0.2, 0.1};
+  SimRobot robot(world, SimRobotOptions{}, start, 1);
+  const auto events = Drive(robot, 0.2, 0.0, 5.0);
+  // Steady state (the command and PWM filters settle within ~1 s): speed within 3 %.
+  const Pose2D a = TruthAt(events, 2 * kSecond), b = TruthAt(events, 5 * kSecond);
+  EXPECT_NEAR(std::hypot(b.x - a.x, b.y - a.y) / 3.0, 0.2, 0.2 * 0.03);
+  // The whole run: 1 m less the start-up lag (about 0.25 s of the filters' time constants).
+  EXPECT_GT(robot.distance_travelled_m(), 0.9);
+  EXPECT_LT(robot.distance_travelled_m(), 1.0);
+  // The firmware's odometry (from the start, in its own frame) agrees with the truth within a few cm.
+  const Pose2D odo = PoseOf(OfKind(events, EventKind::kOdometry).back());
+  const Pose2D truth = start.Inverse().Compose(robot.true_pose());
+  EXPECT_LT(std::hypot(odo.x - truth.x, odo.y - truth.y), 0.03);
+  EXPECT_LT(std::abs(motion::WrapAngle(odo.theta - truth.theta)), 0.05);
+  EXPECT_EQ(robot.collisions(), 0);
+}
+
+TEST(SimRobot, TurnsInPlace) {
+  const World world = Box(2.0);
+  SimRobot robot(world, SimRobotOptions{}, {0, 0, 0}, 2);
+  const auto events = Drive(robot, 0.0, 1.0, 4.0);
+  // Unwrapped true heading from the 100 Hz ground truth; steady yaw rate within 5 % of 1 rad/s.
+  const auto truth = OfKind(events, EventKind::kGroundTruth);
+  double heading = 0.0, at2 = 0.0;
+  for (size_t i = 1; i < truth.size(); ++i) {
+    heading += motion::WrapAngle(PoseOf(truth[i]).theta - PoseOf(truth[i - 1]).theta);
+    if (truth[i].t_us == 2 * kSecond) at2 = heading;
+  }
+  EXPECT_NEAR((heading - at2) / 2.0, 1.0, 0.05);
+  EXPECT_GT(heading, 3.5);
+  EXPECT_LT(heading, 4.0);
+  // The robot stays on the spot (slip moves it a little).
+  EXPECT_LT(std::hypot(robot.true_pose().x, robot.true_pose().y), 0.03);
+  // The firmware's gyro-fused heading is sane.
+  const Pose2D odo = PoseOf(OfKind(events, EventKind::kOdometry).back());
+  EXPECT_LT(std::abs(motion::WrapAngle(odo.theta - robot.true_pose().theta)), 0.1);
+  // The gyro sees the turn (rate + bias + noise).
+  const auto imu = OfKind(events, EventKind::kImu);
+  ASSERT_EQ(imu.size(), 200u);  // 50 Hz
+  EXPECT_NEAR(std::get<Imu>(imu.back().payload).gyro_rad_s[2], 1.0, 0.1);
+}
+
+TEST(SimRobot, EncoderTicksFollowTheWheelRotation) {
+  const World world = Box(3.0);
+  SimRobotOptions o;
+  o.slip_stddev = 0.0;  // ground motion = rotation · r
+  SimRobot robot(world, o, {-1.5, 0, 0}, 3);
+  const auto events = Drive(robot, 0.25, 0.3, 3.0);
+  const auto enc = OfKind(events, EventKind::kEncoders);
+  const auto speeds = OfKind(events, EventKind::kWheelSpeed);
+  ASSERT_EQ(enc.size(), 150u);  // 50 Hz
+  ASSERT_EQ(speeds.size(), enc.size());
+  const double rad_per_tick = o.geometry.RadPerTick();
+  int64_t left = 0, right = 0;
+  for (size_t i = 0; i < enc.size(); ++i) {
+    const auto& e = std::get<EncoderTicks>(enc[i].payload);
+    left += e.left_delta;
+    right += e.right_delta;
+    EXPECT_EQ(e.left_ticks, left);
+    EXPECT_EQ(e.right_ticks, right);
+    EXPECT_EQ(e.delta_time_us, 20000);
+    const auto& s = std::get<MotorCommand>(speeds[i].payload);
+    EXPECT_DOUBLE_EQ(s.a, e.left_delta * rad_per_tick / 0.02);
+    EXPECT_DOUBLE_EQ(s.b, e.right_delta * rad_per_tick / 0.02);
+  }
+  // Distance and turn from the ticks match the truth (within a tick or two of quantisation).
+  const double m_per_tick = rad_per_tick * o.geometry.wheel_radius_m;
+  EXPECT_NEAR(0.5 * (left + right) * m_per_tick, robot.distance_travelled_m(), 2 * m_per_tick);
+  EXPECT_NEAR((right - left) * m_per_tick / (2 * o.geometry.base_radius_m), robot.true_pose().theta, 0.01);
+  EXPECT_GT(right, left);  // turning left
+  EXPECT_EQ(robot.right_ticks(), right);
+
+  // A mirrored right encoder counts down going forward; the firmware's odometry knows it.
+  o.geometry.right_encoder_polarity = -1;
+  SimRobot mirrored(world, o, {-1.5, 0, 0}, 3);
+  const auto straight = Drive(mirrored, 0.2, 0.0, 2.0);
+  EXPECT_LT(std::get<EncoderTicks>(OfKind(straight, EventKind::kEncoders).back().payload).right_ticks, -1000);
+  EXPECT_GT(std::get<MotorCommand>(OfKind(straight, EventKind::kWheelSpeed).back().payload).b, 4.0);
+  const Pose2D odo = PoseOf(OfKind(straight, EventKind::kOdometry).back());
+  EXPECT_NEAR(odo.x, mirrored.true_pose().x + 1.5, 0.01);
+  EXPECT_NEAR(odo.y, mirrored.true_pose().y, 0.01);
+}
+
+TEST(SimRobot, LidarScanMatchesRaycastAtRest) {
+  const World world = Box(2.0);
+  SimRobotOptions o;
+  o.lidar.range_noise_m = 0.0;
+  o.lidar.dropout = 0.0;
+  o.lidar.max_range_m = 2.5;  // the corners (2.83 m away) give no return
+  const Pose2D start{0.3, -0.2, 0.4};
+  SimRobot robot(world, o, start, 4);
+  const auto scans = OfKind(Drive(robot, 0, 0, 0.13), EventKind::kLidar);
+  ASSERT_EQ(scans.size(), 1u);
+  EXPECT_EQ(scans[0].t_us, 125000);
+  const auto& scan = std::get<LidarScan>(scans[0].payload);
+  ASSERT_EQ(scan.ranges_m.size(), 360u);
+  ASSERT_EQ(scan.angles_rad.size(), 360u);
+  ASSERT_EQ(scan.beam_times_us.size(), 360u);
+  EXPECT_FLOAT_EQ(scan.max_range_m, 2.5f);
+  EXPECT_EQ(scan.beam_times_us.front(), 0);
+  EXPECT_GE(scan.beam_times_us.back(), 125000 * 359 / 360);
+  EXPECT_LT(scan.beam_times_us.back(), 125000);
+  int no_returns = 0;
+  for (size_t i = 0; i < scan.ranges_m.size(); ++i) {
+    if (i > 0) {
+      EXPECT_GT(scan.beam_times_us[i], scan.beam_times_us[i - 1]);
+      EXPECT_NEAR(motion::WrapAngle(scan.angles_rad[i] - scan.angles_rad[i - 1]), -2 * M_PI / 360, 1e-5);  // clockwise
+    }
+    const double expected = world.Raycast(start.x, start.y, start.theta + scan.angles_rad[i], 2.5);
+    if (expected >= 2.5) {
+      EXPECT_EQ(scan.ranges_m[i], 0.0f) << i;
+      ++no_returns;
+    } else {
+      EXPECT_FLOAT_EQ(scan.ranges_m[i], static_cast<float>(expected)) << i;
+    }
+  }
+  EXPECT_GT(no_returns, 0);
+  EXPECT_LT(no_returns, 100);
+}
+
+TEST(SimRobot, LidarBeamsAreTakenAtTheirOwnTimesWhileMoving) {
+  const World world = Box(2.0);
+  SimRobotOptions o;
+  o.lidar.range_noise_m = 0.0;
+  o.lidar.dropout = 0.0;
+  o.ground_truth_rate_hz = 1000.0;  // fine truth to interpolate the beams' poses from
+  SimRobot robot(world, o, {-0.5, 0.3, 0}, 5);
+  const auto events = Drive(robot, 0.2, 1.5, 2.0);
+  const auto scans = OfKind(events, EventKind::kLidar);
+  ASSERT_EQ(scans.size(), 16u);
+  const auto& scan = std::get<LidarScan>(scans.back().payload);  // turning at ~1.5 rad/s: 0.19 rad per revolution
+  double worst = 0.0;
+  for (size_t i = 0; i < scan.ranges_m.size(); i += 7) {
+    const Pose2D p = TruthAt(events, scan.beam_times_us[i]);
+    const double expected = world.Raycast(p.x, p.y, p.theta + scan.angles_rad[i], o.lidar.max_range_m);
+    worst = std::max(worst, std::abs(scan.ranges_m[i] - expected));
+  }
+  EXPECT_LT(worst, 0.005);
+}
+
+TEST(SimRobot, StopsAtAWallAndCountsEachContactOnce) {
+  const World world = Box(1.0);
+  SimRobotOptions o;
+  SimRobot robot(world, o, {0, 0, 0}, 6);
+  auto events = Drive(robot, 0.3, 0.0, 6.0);
+  for (const auto& e : OfKind(events, EventKind::kGroundTruth)) {
+    ASSERT_FALSE(world.Collides(PoseOf(e).x, PoseOf(e).y, o.footprint_radius_m)) << e.t_us;
+  }
+  EXPECT_EQ(robot.collisions(), 1);
+  EXPECT_TRUE(robot.in_contact());
+  const auto hits = OfKind(events, EventKind::kCollision);
+  ASSERT_EQ(hits.size(), 1u);
+  EXPECT_EQ(hits[0].channel, "SIM_COLLISION");
+  // It stopped just short of the wall, and the wheels stall: the encoders stop counting.
+  EXPECT_LT(world.ClearanceAt(robot.true_pose().x, robot.true_pose().y), o.footprint_radius_m + 0.005);
+  EXPECT_GT(robot.true_pose().x, 0.85);
+  const auto enc = OfKind(events, EventKind::kEncoders);
+  const auto& at5 = std::get<EncoderTicks>(enc[enc.size() - 51].payload);
+  const auto& at6 = std::get<EncoderTicks>(enc.back().payload);
+  EXPECT_LE(std::abs(at6.left_ticks - at5.left_ticks), 2);
+  EXPECT_LE(std::abs(at6.right_ticks - at5.right_ticks), 2);
+  // Backing off frees it; driving in again is a second contact.
+  Drive(robot, -0.2, 0.0, 7.0);
+  EXPECT_FALSE(robot.in_contact());
+  Drive(robot, 0.3, 0.0, 10.0);
+  EXPECT_EQ(robot.collisions(), 2);
+}
+
+TEST(SimRobot, RejectsAStartInAWall) {
+  const World world = Box(1.0);
+  EXPECT_THROW(SimRobot(world, SimRobotOptions{}, {0.95, 0, 0}, 1), std::invalid_argument);
+  SimRobotOptions bad;
+  bad.lidar.beams = 0;
+  EXPECT_THROW(SimRobot(world, bad, {0, 0, 0}, 1), std::invalid_argument);
+}
+
+// Everything an event carries, exactly.
+std::string Fingerprint(const Event& e) {
+  std::ostringstream s;
+  s << std::hexfloat << e.t_us << ' ' << e.channel << ' ' << int(e.kind) << ':';
+  std::visit(
+      [&s](const auto& p) {
+        using T = std::decay_t<decltype(p)>;
+        if constexpr (std::is_same_v<T, Pose2D>) {
+          s << p.x << ' ' << p.y << ' ' << p.theta;
+        } else if constexpr (std::is_same_v<T, LidarScan>) {
+          for (float r : p.ranges_m) s << ' ' << r;
+        } else if constexpr (std::is_same_v<T, EncoderTicks>) {
+          s << p.left_ticks << ' ' << p.right_ticks;
+        } else if constexpr (std::is_same_v<T, Imu>) {
+          s << p.gyro_rad_s[2] << ' ' << p.angles_rpy_rad[2];
+        } else if constexpr (std::is_same_v<T, MotorCommand>) {
+          s << p.a << ' ' << p.b;
+        }
+      },
+      e.payload);
+  return s.str();
+}
+
+std::vector<std::string> Stream(uint64_t seed) {
+  const World world = Box(1.5);
+  SimRobot robot(world, SimRobotOptions{}, {0, 0, 0}, seed);
+  std::vector<Event> events = Drive(robot, 0.3, 0.5, 1.0);
+  robot.Command(0.1, -1.0);
+  robot.AdvanceTo(2 * kSecond, &events);
+  std::vector<std::string> out;
+  for (const auto& e : events) out.push_back(Fingerprint(e));
+  return out;
+}
+
+TEST(SimRobot, SameSeedSameEventsDifferentSeedDifferent) {
+  const auto a = Stream(7), b = Stream(7), c = Stream(8);
+  ASSERT_FALSE(a.empty());
+  EXPECT_EQ(a, b);
+  EXPECT_NE(a, c);
+}
+
+// --- SimSource --------------------------------------------------------------------------------
+
+std::string WriteArena(const std::string& name, const std::string& text) {
+  const std::string path = test::TempPath(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+const char* kRoom = "name room\nbox -1.5 -1 1.5 1\npose start -0.5 0 0\n";
+
+SourceOptions ParseSource(const std::string& ini) {
+  const auto config = config::Config::FromString(ini, "t.ini");
+  config::Section s = config.GetSection("source");
+  SourceOptions o = ParseSourceOptions(s);
+  s.Finish();
+  return o;
+}
+
+std::string ConfigErrorOf(const std::string& ini) {
+  try {
+    ParseSource(ini);
+  } catch (const config::ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(SimSource, StreamIsTimeOrderedAndEndsAtDuration) {
+  const std::string path = WriteArena("room.arena", kRoom);
+  EXPECT_EQ(DetectFormat(path), "sim");
+  SourceOptions o = ParseSource("[source]\npath = " + path + "\nduration_s = 1.5\n");  // type auto
+  EXPECT_DOUBLE_EQ(o.sim.duration_s, 1.5);
+  auto source = OpenSource(o);
+  EXPECT_EQ(source->Format(), "simulator");
+  EXPECT_EQ(source->channels().size(), 8u);
+  EXPECT_EQ(source->channels().at("LIDAR").kind, EventKind::kLidar);
+  int64_t last = 0;
+  size_t n = 0, scans = 0;
+  while (auto e = source->Next()) {
+    EXPECT_GE(e->t_us, last);
+    EXPECT_EQ(e->stamp_us, e->t_us);
+    last = e->t_us;
+    scans += e->kind == EventKind::kLidar;
+    ++n;
+  }
+  EXPECT_EQ(last, 1500000);
+  EXPECT_EQ(scans, 12u);
+  EXPECT_GT(n, 500u);
+  EXPECT_DOUBLE_EQ(source->Progress(), 1.0);
+  EXPECT_FALSE(source->Next());
+  auto* sim = dynamic_cast<SimSource*>(source.get());
+  ASSERT_NE(sim, nullptr);
+  EXPECT_NEAR(sim->robot().true_pose().x, -0.5, 1e-12);  // the arena's start, never commanded
+}
+
+TEST(SimSource, VelocityCommandsDriveTheRobot) {
+  SourceOptions o;
+  o.type = "sim";
+  o.path = WriteArena("room_cmd.arena", kRoom);
+  o.sim.duration_s = 3.0;
+  SimSource sim(o);
+  Sink& sink = sim;
+  auto until = [&sim](double t_s) {
+    while (auto e = sim.Next()) {
+      if (e->t_us >= t_s * kSecond) return true;
+    }
+    return false;
+  };
+  ASSERT_TRUE(until(0.5));
+  EXPECT_EQ(sim.robot().distance_travelled_m(), 0.0);
+  sink.Send(Event{500000, 500000, "MBOT_VEL_CMD", EventKind::kMotorCommand,
+                  MotorCommand{MotorCommand::Kind::kVelocity, 0.2, 0.0}});
+  sink.Send(Event{500000, 500000, "MBOT_MOTOR_PWM", EventKind::kMotorCommand,
+                  MotorCommand{MotorCommand::Kind::kPwm, 0.0, 0.0}});  // ignored
+  sink.Send(Event{500000, 500000, "TRUE_POSE", EventKind::kGroundTruth, Pose2D{}});  // ignored
+  ASSERT_TRUE(until(2.5));
+  EXPECT_GT(sim.robot().true_pose().x, -0.5 + 0.3);
+  EXPECT_NEAR(sim.Progress(), 2.5 / 3.0, 0.01);
+  sim.RequestEnd();
+  EXPECT_FALSE(sim.Next());
+  EXPECT_DOUBLE_EQ(sim.Progress(), 1.0);
+  EXPECT_LT(sim.robot().now_us(), 3 * kSecond);
+}
+
+TEST(SimSource, OptionsAreStrictAndOnlyForTheSimulator) {
+  const std::string arena = WriteArena("room_opts.arena", kRoom);
+  const std::string base = "[source]\ntype = sim\npath = " + arena + "\n";
+  const SourceOptions o = ParseSource(base + "start = 1, -0.5, 90\nlidar_beams = 720\nright_motor_gain = 0.9\n"
+                                             "firmware_rate_hz = 100\n");
+  ASSERT_TRUE(o.sim.start.has_value());
+  EXPECT_DOUBLE_EQ(o.sim.start->x, 1.0);
+  EXPECT_DOUBLE_EQ(o.sim.start->theta, M_PI / 2);
+  EXPECT_EQ(o.sim.robot.lidar.beams, 720);
+  EXPECT_DOUBLE_EQ(o.sim.robot.right_motor_gain, 0.9);
+  EXPECT_DOUBLE_EQ(o.sim.robot.controller.dt_s, 0.01);
+  EXPECT_DOUBLE_EQ(o.sim.duration_s, 600.0);
+
+  std::string e = ConfigErrorOf(base + "lidar_beam = 720\n");
+  EXPECT_NE(e.find("[source] lidar_beam: unknown key"), std::string::npos) << e;
+  e = ConfigErrorOf(base + "lidar_dropout = 2\n");
+  EXPECT_NE(e.find("[source] lidar_dropout"), std::string::npos) << e;
+  e = ConfigErrorOf(base + "start = 1, 2\n");
+  EXPECT_NE(e.find("[source] start"), std::string::npos) << e;
+  // A start in a wall is an error naming the world file.
+  SourceOptions in_wall = ParseSource(base + "start = 1.45, 0, 0\n");
+  try {
+    SimSource sim(in_wall);
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& err) {
+    const std::string what = err.what();
+    EXPECT_NE(what.find("room_opts.arena: sim robot: the start pose"), std::string::npos) << what;
+  }
+  // A grid world has no start pose: `start` is required.
+  e = ConfigErrorOf("[source]\ntype = sim\npath = /somewhere/maze.map\n");
+  EXPECT_NE(e.find("[source] start: required"), std::string::npos) << e;
+  // Simulator keys are unknown for any other source.
+  e = ConfigErrorOf("[source]\ntype = lcm_log\npath = x.log\nduration_s = 5\n");
+  EXPECT_NE(e.find("[source] duration_s: unknown key"), std::string::npos) << e;
+}
+
+// Not a pass/fail figure: how fast the simulator runs with default options on a maze-sized arena
+// (4.8 m square, 8 x 8 cells of 0.6 m, internal walls), every event drained.
+TEST(SimSource, SpeedOnAMazeArena) {
+  std::ostringstream a;
+  a << "name maze\nbox 0 0 4.8 4.8\npose start 0.3 0.3 0\n";
+  for (int i = 1; i < 8; ++i) {
+    for (int j = 0; j < 8; ++j) {
+      const double u = i * 0.6, v0 = j * 0.6, v1 = (j + 1) * 0.6;
+      if ((i * 5 + j * 3) % 4 == 0) a << "wall " << u << ' ' << v0 << ' ' << u << ' ' << v1 << '\n';  // vertical
+      if ((i * 3 + j * 7) % 4 == 1) a << "wall " << v0 << ' ' << u << ' ' << v1 << ' ' << u << '\n';  // horizontal
+    }
+  }
+  SourceOptions o;
+  o.type = "sim";
+  o.path = WriteArena("maze.arena", a.str());
+  o.sim.duration_s = 60.0;
+  SimSource sim(o);
+  // A roaming robot: drive ahead, turn in place when a wall is near in front (a cheap bumper on the
+  // true pose, every 10 ms, so the figure is for a moving robot, not one pushing against a wall).
+  const auto t0 = std::chrono::steady_clock::now();
+  size_t n = 0;
+  while (auto e = sim.Next()) {
+    ++n;
+    if (e->kind != EventKind::kGroundTruth) continue;
+    const Pose2D& p = PoseOf(*e);
+    bool blocked = false;
+    for (double a : {-1.2, -0.6, 0.0, 0.6, 1.2}) {
+      blocked = blocked || sim.world().Raycast(p.x, p.y, p.theta + a, 1.0) < 0.3;
+    }
+    sim.Send(Event{e->t_us, e->t_us, "MBOT_VEL_CMD", EventKind::kMotorCommand,
+                   MotorCommand{MotorCommand::Kind::kVelocity, blocked ? 0.0 : 0.3, blocked ? 1.5 : 0.0}});
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double speed = o.sim.duration_s / wall;
+  std::cout << "[ sim      ] " << n << " events, " << o.sim.duration_s << " s simulated in " << wall * 1e3
+            << " ms: " << speed << " x real time (" << sim.world().walls().size() << " walls, "
+            << sim.robot().distance_travelled_m() << " m driven, " << sim.robot().collisions() << " collisions)\n";
+  RecordProperty("sim_seconds_per_wall_second", std::to_string(speed));
+  EXPECT_GT(n, 20000u);
+  EXPECT_GT(sim.robot().distance_travelled_m(), 5.0);
+}
+
+}  // namespace
+}  // namespace mbot::drivers
