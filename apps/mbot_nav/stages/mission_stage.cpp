@@ -5,8 +5,8 @@
 // MBOT_VEL_CMD (to the simulator, or to a robot over LCM). States go out as kStatus events.
 // The same stage drives the simulator, a live robot, and does nothing harmful on a log (nobody
 // listens to its commands there).
+#include <algorithm>
 #include <cmath>
-#include <deque>
 #include <iostream>
 
 #include "mbot/common/atomic_file.hpp"
@@ -79,7 +79,10 @@ class MissionStage : public Stage {
         return;
       case EventKind::kOdometry:
         odometry_.push_back({ev.t_us, std::get<Pose2D>(ev.payload)});
-        while (odometry_.size() > 2 && odometry_.front().t_us < ev.t_us - 5'000'000) odometry_.pop_front();
+        if (odometry_.front().t_us < ev.t_us - 10'000'000) {  // trim to 5 s now and then, not every message
+          odometry_.erase(odometry_.begin(), std::lower_bound(odometry_.begin(), odometry_.end(), ev.t_us - 5'000'000,
+                                                              [](const TimedPose& p, int64_t t) { return p.t_us < t; }));
+        }
         Control(ev.t_us);
         return;
       default:
@@ -102,8 +105,7 @@ class MissionStage : public Stage {
   bool PoseNow(int64_t t_us, Pose2D* pose) const {
     if (!has_slam_ || odometry_.empty()) return false;
     Pose2D odo_then;
-    const std::vector<TimedPose> odo(odometry_.begin(), odometry_.end());
-    if (!motion::InterpolateAt(odo, slam_.t_us, 200'000, &odo_then)) return false;
+    if (!motion::InterpolateAt(odometry_, slam_.t_us, 200'000, &odo_then)) return false;
     const Pose2D delta = odo_then.Inverse().Compose(odometry_.back().pose);
     *pose = slam_.pose.Compose(delta);
     (void)t_us;
@@ -255,7 +257,7 @@ class MissionStage : public Stage {
   TimedPose slam_;
   bool has_slam_ = false;
   int64_t first_slam_us_ = -1, last_control_us_ = -1, last_explore_us_ = -1;
-  std::deque<TimedPose> odometry_;
+  std::vector<TimedPose> odometry_;  // the last ~5 s
   std::shared_ptr<const mapping::OccupancyGrid> map_;
   bool started_ = false;
   bool explored_ = false;  // the explorer is done; the controller finishes at home

@@ -160,11 +160,8 @@ std::string DetectFormat(const std::string& path) {
   if (!std::filesystem::is_regular_file(path)) throw std::runtime_error(path + ": no such file");
   if (EndsWith(path, ".arena")) return "sim";
   if (IsMapFile(path)) return "map";
-  const auto ends_with = [&path](const std::string& s) {
-    return path.size() >= s.size() && path.compare(path.size() - s.size(), s.size(), s) == 0;
-  };
-  if (ends_with(".rawlog") || ends_with(".rawlog.gz")) return "rawlog";
-  if (ends_with(".csv") && IsMotorSamplesFile(path)) return "motor_csv";
+  if (EndsWith(path, ".rawlog") || EndsWith(path, ".rawlog.gz")) return "rawlog";
+  if (EndsWith(path, ".csv") && IsMotorSamplesFile(path)) return "motor_csv";
   unsigned char head[4] = {0, 0, 0, 0};
   {
     std::ifstream in(path, std::ios::binary);
