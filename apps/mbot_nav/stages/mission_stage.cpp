@@ -102,13 +102,12 @@ class MissionStage : public Stage {
 
  private:
   // The pose now: the SLAM pose at its scan, moved on by what odometry says happened since.
-  bool PoseNow(int64_t t_us, Pose2D* pose) const {
+  bool PoseNow(Pose2D* pose) const {
     if (!has_slam_ || odometry_.empty()) return false;
     Pose2D odo_then;
     if (!motion::InterpolateAt(odometry_, slam_.t_us, 200'000, &odo_then)) return false;
     const Pose2D delta = odo_then.Inverse().Compose(odometry_.back().pose);
     *pose = slam_.pose.Compose(delta);
-    (void)t_us;
     return true;
   }
 
@@ -200,7 +199,7 @@ class MissionStage : public Stage {
     const double dt = last_control_us_ >= 0 ? (t_us - last_control_us_) * 1e-6 : 0.0;
     last_control_us_ = t_us;
     Pose2D pose;
-    if (!PoseNow(t_us, &pose) || (t_us - first_slam_us_) * 1e-6 < o_.start_delay_s) {
+    if (!PoseNow(&pose) || (t_us - first_slam_us_) * 1e-6 < o_.start_delay_s) {
       SetState("initializing", "waiting for SLAM", t_us);
       Send(0, 0, t_us);
       return;

@@ -133,9 +133,7 @@ class RefereeStage : public Stage {
       << 100 * mq.coverage << "%" << std::setw(6) << map_points << std::setw(6) << time_points << std::setw(6)
       << autonomy_points << std::setw(7) << total << std::setw(6) << collisions_ << std::setw(6) << std::setprecision(0)
       << rtf << "x\n";
-    if (o_.event == "maze_explorer" || o_.event == "speed_run") {
-      t << "(Heavy Lift needs the forklift and AprilTag vision: not run. Warehouse: not yet in this build.)\n";
-    }
+    t << "(Heavy Lift needs the forklift and AprilTag vision: not run. Warehouse: not yet in this build.)\n";
     std::cout << t.str() << std::flush;
 
     std::ostringstream j;
