@@ -2,9 +2,11 @@
 #include <csignal>
 #include <cstring>
 #include <iostream>
+#include <optional>
 
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
+#include "competition.hpp"
 #include "pipeline.hpp"
 
 namespace {
@@ -20,6 +22,8 @@ constexpr const char* kUsage = R"(usage: mbot_nav --config FILE [--set section.k
 Runs the pipeline that FILE describes: [pipeline] stages = ... names the stage sections, each with
 type = <stage type> and its keys; [source] path = ... is the input; [output] dir = ... gets every
 output. `${datasets}` in a value is the shared datasets folder (MBOT_DATASETS_DIR).
+A FILE with a [competition] section runs several events, each its own pipeline config, and prints
+one score table (config/competition.ini: --set competition.seed=N, --set <event>.world=FILE).
 
 options:
   --config FILE          the INI file (include = other.ini pulls in shared defaults)
@@ -95,6 +99,7 @@ int main(int argc, char** argv) {
   }
 
   mbot::app::PipelinePlan plan;
+  std::optional<mbot::app::CompetitionPlan> competition;
   try {
     auto config = mbot::config::Config::Load(config_path);
     for (const auto& s : sets) config.Set(s);
@@ -102,14 +107,27 @@ int main(int argc, char** argv) {
       std::cout << config.ToIni();
       return 0;
     }
-    plan = mbot::app::BuildPlan(config);
+    if (mbot::app::IsCompetition(config)) {
+      competition = mbot::app::BuildCompetition(config);
+    } else {
+      plan = mbot::app::BuildPlan(config);
+    }
   } catch (const mbot::config::ConfigError& e) {
+    std::cerr << "mbot_nav: configuration error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::runtime_error& e) {  // an event's config file that does not load
     std::cerr << "mbot_nav: configuration error: " << e.what() << "\n";
     return 2;
   }
 
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
+  if (competition) {
+    const int status = mbot::app::RunCompetition(*competition, g_stop);
+    std::fprintf(stderr, "%s: %d warnings; outputs in %s\n", status == 130 ? "interrupted" : status ? "failed" : "done",
+                 mbot::log::WarningCount(), competition->output_dir.c_str());
+    return status;
+  }
   try {
     const auto summary = mbot::app::RunPlan(plan, g_stop);
     std::fprintf(stderr, "%s: %lld events, %.1f s of data in %.2f s wall (%.0fx real time), %d warnings; outputs in %s\n",

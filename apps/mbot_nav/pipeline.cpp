@@ -139,7 +139,7 @@ RunSummary RunPlan(PipelinePlan& plan, const std::atomic<bool>& stop) {
   plan.source.seed = plan.pipeline.seed;
   std::unique_ptr<drivers::Source> source = drivers::OpenSource(plan.source);
   PipelineBus bus(plan.stages, dynamic_cast<drivers::Sink*>(source.get()));
-  RunContext ctx{plan.output.dir, plan.pipeline.seed, source.get(), plan.source.path, &bus};
+  RunContext ctx{plan.output.dir, plan.pipeline.seed, source.get(), plan.source.path, &bus, &summary.results};
   for (auto& [name, stage] : plan.stages) stage->Start(ctx);
 
   Progress progress(plan.pipeline.progress);

@@ -37,6 +37,9 @@ struct RunContext {
   const drivers::Source* source = nullptr;
   std::string source_path;
   Bus* bus = nullptr;  // set by the pipeline; valid from Start to Finish
+  // A stage's headline results (key, value), added in Finish, returned in RunSummary::results: what a
+  // caller running several pipelines (the competition) gathers into one table. Valid in Finish.
+  std::vector<std::pair<std::string, std::string>>* results = nullptr;
 };
 
 class Stage {

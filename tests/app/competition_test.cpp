@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "../regression/run_config.hpp"
+#include "competition.hpp"
 
 namespace mbot::app {
 namespace {
@@ -42,6 +43,25 @@ TEST_P(MazeExplorer, MapsTheReachableSpaceAndReturnsHomeWithoutCollision) {
 }
 INSTANTIATE_TEST_SUITE_P(Seeds, MazeExplorer, ::testing::Values(1, 2));
 
+class Warehouse : public ::testing::TestWithParam<int> {};
+
+// A random start in the known map (seeded), global localization, then all seven deliveries: the
+// referee judges each stop from the true pose (within 0.08 m and 15 deg for 2 s, in order).
+TEST_P(Warehouse, LocalizesGloballyAndReachesLevel3InTimeWithoutCollision) {
+  const int seed = GetParam();
+  const std::string j = RunConfig("warehouse.ini", "warehouse_" + std::to_string(seed),
+                                  {"pipeline.seed=" + std::to_string(seed)}, "score.json");
+  ASSERT_FALSE(j.empty());
+  EXPECT_NE(j.find("\"completed\": true"), std::string::npos) << j;
+  EXPECT_EQ(Get(j, {"collisions"}), 0);
+  EXPECT_EQ(Get(j, {"levels_reached"}), 3) << j;
+  EXPECT_LT(Get(j, {"time_s"}), 720.0);
+  EXPECT_LT(Get(j, {"localized_at_s"}), 10.0);
+  EXPECT_LT(std::hypot(Get(j, {"slam_final_error", "x_m"}), Get(j, {"slam_final_error", "y_m"})), 0.05);
+  for (const char* k : {"time_s", "localized_at_s", "real_time_factor"}) RecordProperty(k, std::to_string(Get(j, {k})));
+}
+INSTANTIATE_TEST_SUITE_P(Seeds, Warehouse, ::testing::Values(1, 2));
+
 // Ctrl-C in the middle of an event (a stage raises the flag the signal handler would, after 8,000
 // events, ~22 s into the maze): the map, the trajectories and the score are still written.
 class StopAfter : public Stage {
@@ -76,6 +96,49 @@ TEST(MazeExplorer, InterruptedRunStillWritesMapTrajectoriesAndScore) {
   for (const char* f : {"final_map.png", "final_map.map", "true_path.tum", "slam_path.tum", "mission.json"}) {
     EXPECT_GT(std::filesystem::file_size(out + "/" + f), 0u) << f;
   }
+}
+
+// The README's first command: config/competition.ini runs every simulated event with one seed and
+// writes one table; Heavy Lift is listed as not run.
+TEST(Competition, RunsEveryEventAndWritesOneTable) {
+  auto c = config::Config::Load(std::string(MBOT_SOURCE_DIR) + "/config/competition.ini");
+  const std::string out = ::testing::TempDir() + "/competition";
+  std::filesystem::remove_all(out);
+  c.Set("output.dir=" + out);
+  CompetitionPlan plan = BuildCompetition(c);
+  ASSERT_EQ(plan.events.size(), 3u);
+  std::atomic<bool> stop{false};
+  EXPECT_EQ(RunCompetition(plan, stop), 0);
+  std::ifstream in(out + "/competition.json");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string j = ss.str();
+  for (const char* e : {"Speed Run", "Maze Explorer", "Warehouse"}) EXPECT_NE(j.find(e), std::string::npos) << j;
+  EXPECT_NE(j.find("Heavy Lift: needs the forklift"), std::string::npos) << j;
+  EXPECT_EQ(Get(j, {"max_points"}), 300);  // the first event's: Speed Run scores pose, map, lap
+  EXPECT_GE(Get(j, {"not_run", "points"}), 900) << j;  // of 1000
+  for (const char* e : {"speed_run", "maze_explorer", "warehouse"}) {
+    for (const char* f : {"score.json", "final_map.png", "true_path.tum", "slam_path.tum"}) {
+      EXPECT_TRUE(std::filesystem::exists(out + "/" + e + "/" + f)) << e << "/" << f;
+    }
+  }
+}
+
+TEST(Competition, ConfigErrorsNameTheSectionAndKeyBeforeAnythingRuns) {
+  const std::string dir = std::string(MBOT_SOURCE_DIR) + "/config";
+  auto expect_error = [&](const std::string& text, const std::string& what) {
+    try {
+      BuildCompetition(config::Config::FromString(text, "bad.ini", dir));
+      ADD_FAILURE() << "no error for: " << text;
+    } catch (const config::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  expect_error("[competition]\nevents = speed_run\n", "event 'speed_run' has no [speed_run] section");
+  expect_error("[competition]\nevents = speed_run\n[speed_run]\nconfig = " + dir + "/speed_run.ini\n[maze]\nconfig = x\n", "[maze] is not used");
+  expect_error("[competition]\nevents = speed_run\n[speed_run]\nconfig = " + dir + "/speed_run.ini\nset = mission.max_sped_m_s=1\n", "max_sped_m_s");
+  expect_error("[competition]\nevents = speed_run\n[speed_run]\n", "[speed_run] config: required");
+  expect_error("[competition]\nevents = speed_run\n[speed_run]\nconfig = nowhere.ini\n", "[speed_run] config: nowhere.ini");
 }
 
 }  // namespace

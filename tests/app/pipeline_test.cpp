@@ -1,3 +1,4 @@
+#include "competition.hpp"
 #include "pipeline.hpp"
 
 #include <gtest/gtest.h>
@@ -50,7 +51,12 @@ TEST(PipelineTest, EveryShippedConfigIsValid) {
   for (const auto& entry : std::filesystem::directory_iterator(std::string(MBOT_SOURCE_DIR) + "/config")) {
     if (entry.path().extension() != ".ini" || entry.path().filename() == "defaults.ini") continue;
     SCOPED_TRACE(entry.path().string());
-    EXPECT_NO_THROW(BuildPlan(config::Config::Load(entry.path().string())));
+    const config::Config c = config::Config::Load(entry.path().string());
+    if (IsCompetition(c)) {
+      EXPECT_NO_THROW(BuildCompetition(c));
+    } else {
+      EXPECT_NO_THROW(BuildPlan(c));
+    }
     ++n;
   }
   EXPECT_GE(n, 3);

@@ -1,5 +1,6 @@
-// `mission`: the robot's autonomy after SLAM — what to do (follow a circuit of waypoints, or explore
-// and return home), how to get there (the explorer's A* paths) and the motion controller that turns
+// `mission`: the robot's autonomy after SLAM — what to do (follow a circuit of waypoints, explore
+// and return home, or the Warehouse's deliveries in a known map once global localization has
+// settled), how to get there (A* paths) and the motion controller that turns
 // the pose into velocity commands. It runs on every odometry message (the firmware's 50 Hz): the
 // pose is the latest SLAM pose moved on by the odometry since that scan, the command goes out on
 // MBOT_VEL_CMD (to the simulator, or to a robot over LCM). States go out as kStatus events.
@@ -16,6 +17,7 @@
 #include "mbot/motion/motion_controller.hpp"
 #include "mbot/planning/exploration.hpp"
 #include "mbot/planning/planning_config.hpp"
+#include "warehouse.hpp"
 #include "report.hpp"
 #include "stages.hpp"
 
@@ -26,7 +28,11 @@ using drivers::EventKind;
 using motion::Pose2D;
 using motion::TimedPose;
 
-enum class Task { kWaypoints, kExplore };
+enum class Task { kWaypoints, kExplore, kWarehouse };
+
+constexpr double kEscapeM = 0.30;  // how far a robot inside the planning radius may step out first [m]
+
+const char* TaskName(Task t) { return t == Task::kWaypoints ? "waypoints" : t == Task::kExplore ? "explore" : "warehouse"; }
 
 struct MissionOptions {
   Task task = Task::kWaypoints;
@@ -42,8 +48,11 @@ struct MissionOptions {
   double control_lag_s = 0.2;
   int max_corrections = 5;
   double stuck_s = 1.0;                 // commanded to move but not moving this long: back off
-  double backoff_s = 0.6;               // reversing at 0.1 m/s              // drives back to the final pose when it stopped outside the tolerances
+  double backoff_s = 0.6;               // reversing at 0.1 m/s
+  int max_stalls = 10;                  // stalls on the way to one goal before the mission gives up
+  double dwell_s = warehouse::kDwellS + 0.5;  // warehouse: standing at a stop (lifting, setting down) [s]
   std::string status_channel = "MISSION_STATUS";
+  std::string slam_status_channel = "SLAM_STATUS";
 };
 
 class MissionStage : public Stage {
@@ -53,6 +62,10 @@ class MissionStage : public Stage {
 
   void Start(const RunContext& ctx) override {
     bus_ = ctx.bus;
+    if (o_.task == Task::kWarehouse) {
+      stops_ = warehouse::Stops(drivers::World::Load(ctx.source_path), ctx.seed);
+      planner_ = planning::AStarPlanner(o_.exploration.astar);
+    }
     if (o_.task == Task::kWaypoints && o_.waypoints.empty()) {
       if (!o_.waypoints_from_arena) throw std::runtime_error("mission: no waypoints given");
       const drivers::World world = drivers::World::Load(ctx.source_path);
@@ -77,6 +90,9 @@ class MissionStage : public Stage {
       case EventKind::kMap:
         map_ = std::get<std::shared_ptr<const mapping::OccupancyGrid>>(ev.payload);
         return;
+      case EventKind::kStatus:
+        if (ev.channel == o_.slam_status_channel) slam_status_ = std::get<drivers::Status>(ev.payload);
+        return;
       case EventKind::kOdometry:
         odometry_.push_back({ev.t_us, std::get<Pose2D>(ev.payload)});
         if (odometry_.front().t_us < ev.t_us - 10'000'000) {  // trim to 5 s now and then, not every message
@@ -92,11 +108,16 @@ class MissionStage : public Stage {
 
   void Finish(const RunContext& ctx, bool interrupted) override {
     std::ostringstream j;
-    j << "{\n  \"task\": " << JsonString(o_.task == Task::kWaypoints ? "waypoints" : "explore")
+    j << "{\n  \"task\": " << JsonString(TaskName(o_.task))
       << ",\n  \"state\": " << JsonString(state_) << ",\n  \"detail\": " << JsonString(detail_)
       << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"commands\": " << commands_
       << ",\n  \"paths\": " << paths_ << ",\n  \"stale_pose_stops\": " << stale_stops_
-      << ",\n  \"corrections\": " << corrections_ << ",\n  \"stall_recoveries\": " << recoveries_ << "\n}\n";
+      << ",\n  \"corrections\": " << total_corrections_ << ",\n  \"stall_recoveries\": " << recoveries_;
+    if (o_.task == Task::kWarehouse) {
+      j << ",\n  \"stops\": " << stops_.size() << ",\n  \"stops_done\": " << stop_index_
+        << ",\n  \"localized_at_s\": " << (localized_us_ >= 0 ? Num((localized_us_ - first_slam_us_) * 1e-6) : "null");
+    }
+    j << "\n}\n";
     WriteFileAtomically(ctx.output_dir + "/mission.json", [&](std::ostream& out) { out << j.str(); });
   }
 
@@ -129,31 +150,127 @@ class MissionStage : public Stage {
     if (stuck_since_us_ < 0) stuck_since_us_ = t_us;
     if ((t_us - stuck_since_us_) * 1e-6 < o_.stuck_s) return false;
     ++recoveries_;
+    if (++stalls_this_goal_ > o_.max_stalls) {
+      SetState("failed", "stalled " + std::to_string(stalls_this_goal_) + " times on the way to one goal", t_us);
+      Send(0, 0, t_us);
+      return true;
+    }
     mbot::log::Warn("mission: stalled for " + Num(o_.stuck_s, 3) + " s while commanded to move: backing off");
     stuck_since_us_ = -1;
     last_command_ = {};
     backoff_until_us_ = t_us + static_cast<int64_t>(o_.backoff_s * 1e6);
     last_explore_us_ = -1;  // replan as soon as the back-off ends
+    if (o_.task == Task::kWarehouse && final_leg_) need_plan_ = true;
     Send(-0.1, 0.0, t_us);
     return true;
   }
 
-  // At the final pose: the controller has stopped commanding, but the wheels lag, so wait until the
-  // robot stands still, then check the pose; outside the tolerances, drive to it again.
-  void Settle(const Pose2D& pose, int64_t t_us) {
+  // At the final pose (goal_): the controller has stopped commanding, but the wheels lag, so wait
+  // until the robot stands still, then check the pose; outside the tolerances, drive to it again.
+  // True once it stands at the goal (or the corrections are spent); *how says how well.
+  bool Settled(const Pose2D& pose, int64_t t_us, std::string* how) {
     const motion::VelocityCommand v = MeasuredVelocity();
-    if (std::abs(v.v_m_s) > 0.005 || std::abs(v.w_rad_s) > 0.02) return;
-    const Pose2D goal = o_.task == Task::kWaypoints ? o_.waypoints.back() : explorer_.home();
-    const double d = std::hypot(goal.x - pose.x, goal.y - pose.y);
-    const double e = std::abs(motion::WrapAngle(goal.theta - pose.theta));
-    const std::string done = o_.task == Task::kWaypoints ? "circuit driven" : "explored and home";
+    if (std::abs(v.v_m_s) > 0.005 || std::abs(v.w_rad_s) > 0.02) return false;
+    const double d = std::hypot(goal_.x - pose.x, goal_.y - pose.y);
+    const double e = std::abs(motion::WrapAngle(goal_.theta - pose.theta));
     if ((d <= o_.controller.final_tolerance_m && e <= o_.controller.final_heading_tolerance_rad) || corrections_ >= o_.max_corrections) {
-      SetState("completed", done + " (" + std::to_string(corrections_) + " corrections; off by " + Num(d, 3) + " m, " +
-                                Num(e * 180 / M_PI, 3) + " deg by its own estimate)", t_us);
+      *how = std::to_string(corrections_) + " corrections; off by " + Num(d, 3) + " m, " + Num(e * 180 / M_PI, 3) +
+             " deg by its own estimate";
+      return true;
+    }
+    ++corrections_, ++total_corrections_;
+    SetPath({goal_}, t_us);
+    return false;
+  }
+
+  // The Warehouse: stand still until global localization has settled, then drive to each stop in
+  // turn (A* on the known map), stand there for dwell_s, and go on. False when it has already
+  // commanded the robot this step (standing still).
+  bool WarehouseStep(const Pose2D& pose, int64_t t_us) {
+    if (slam_status_.state != "localized") {
+      SetState("localizing", "waiting for SLAM to localize (it says " +
+                                 (slam_status_.state.empty() ? std::string("nothing yet") : slam_status_.state) + ")", t_us);
+      if (final_leg_) need_plan_ = true;  // the path was planned from a pose no longer trusted
+      Send(0, 0, t_us);
+      return false;
+    }
+    if (localized_us_ < 0) localized_us_ = t_us;
+    if (!planner_.has_map()) {
+      if (!map_) {
+        SetState("localizing", "waiting for the known map", t_us);
+        Send(0, 0, t_us);
+        return false;
+      }
+      planner_.SetMap(planning::ObstacleDistanceGrid(*map_, o_.exploration.distance));
+    }
+    if (dwell_until_us_ >= 0) {
+      if (t_us < dwell_until_us_) {
+        Send(0, 0, t_us);
+        return false;
+      }
+      dwell_until_us_ = -1;
+      if (++stop_index_ == stops_.size()) {
+        SetState("completed", std::to_string(warehouse::TotalDeliveries()) + " deliveries made", t_us);
+        Send(0, 0, t_us);
+        return false;
+      }
+      need_plan_ = true;
+    }
+    if (need_plan_ && t_us >= backoff_until_us_) {
+      const warehouse::Stop& stop = stops_[stop_index_];
+      const planning::PlanResult r = PlanFrom(pose, stop.pose);
+      if (r.status != planning::PlanStatus::kFound) {
+        SetState("failed", "no path to " + stop.Name() + ": " + planning::ToString(r.status), t_us);
+        Send(0, 0, t_us);
+        return false;
+      }
+      need_plan_ = false;
+      goal_ = stop.pose;
+      final_leg_ = true;
+      corrections_ = 0;
+      SetPath(r.path, t_us);
+      SetState("driving", "to " + stop.Name() + " of " + std::to_string(warehouse::TotalDeliveries()), t_us);
+    }
+    return true;
+  }
+
+  // A* from the pose to the goal. A robot closer to a wall than the planning radius (it was pushed,
+  // or localization was wrong for a while) first steps straight out to the nearest place that keeps
+  // the radius, when one within escape_m is reachable by a segment that keeps half of it.
+  planning::PlanResult PlanFrom(const Pose2D& pose, const Pose2D& goal) {
+    planning::PlanResult r = planner_.Plan(pose, goal);
+    if (r.status != planning::PlanStatus::kStartInCollision) return r;
+    const double radius = o_.exploration.astar.robot_radius_m, res = map_ ? map_->resolution() : 0.05;
+    for (double d = res; d <= kEscapeM; d += res) {
+      for (int k = 0; k < 32; ++k) {
+        const double a = pose.theta + k * M_PI / 16;
+        const Pose2D out{pose.x + d * std::cos(a), pose.y + d * std::sin(a), a};
+        if (planner_.DistanceAt(out.x, out.y) <= radius + 0.5 * res ||
+            !planner_.SegmentIsClear(pose.x, pose.y, out.x, out.y, 0.5 * radius)) {
+          continue;
+        }
+        planning::PlanResult rest = planner_.Plan(out, goal);
+        if (rest.status != planning::PlanStatus::kFound) continue;
+        rest.path.insert(rest.path.begin(), pose);
+        mbot::log::Info("mission: " + Num(planner_.DistanceAt(pose.x, pose.y), 3) + " m from a wall: stepping out " +
+                        Num(d, 3) + " m first");
+        return rest;
+      }
+    }
+    return r;
+  }
+
+  // The goal is reached and the robot stands at it.
+  void Arrived(const std::string& how, int64_t t_us) {
+    final_leg_ = false;
+    stalls_this_goal_ = 0;
+    if (o_.task != Task::kWarehouse) {
+      SetState("completed", std::string(o_.task == Task::kWaypoints ? "circuit driven" : "explored and home") + " (" + how + ")", t_us);
       return;
     }
-    ++corrections_;
-    SetPath({goal}, t_us);
+    const warehouse::Stop& stop = stops_[stop_index_];
+    dwell_until_us_ = t_us + static_cast<int64_t>(o_.dwell_s * 1e6);
+    SetState(stop.pickup ? "lifting" : "setting_down", "at " + stop.Name() + " (" + how + ")", t_us);
   }
 
   // Body velocity from odometry over the last 0.1 s.
@@ -217,10 +334,13 @@ class MissionStage : public Stage {
     if (o_.task == Task::kWaypoints) {
       if (!started_) {
         started_ = true;
+        goal_ = o_.waypoints.back();
+        final_leg_ = true;
         SetPath(o_.waypoints, t_us);
         SetState("driving", "circuit of " + std::to_string(o_.waypoints.size()) + " waypoints", t_us);
       }
-    } else if (!explored_ && map_ && (last_explore_us_ < 0 || (t_us - last_explore_us_) * 1e-6 >= o_.explore_period_s)) {
+    } else if (o_.task == Task::kExplore && !explored_ && map_ &&
+               (last_explore_us_ < 0 || (t_us - last_explore_us_) * 1e-6 >= o_.explore_period_s)) {
       last_explore_us_ = t_us;
       const planning::ExplorationUpdate u = explorer_.Update(*map_, pose, t_us * 1e-6);
       if (u.state == planning::ExplorationState::kFailed) {
@@ -237,16 +357,21 @@ class MissionStage : public Stage {
       }
       if (u.state == planning::ExplorationState::kCompleted) {
         explored_ = true;  // at home: the controller settles the final pose, then the mission is complete
+        goal_ = explorer_.home();
+        final_leg_ = true;
         SetState("returning_home", "aligning at home", t_us);
       } else {
         SetState(planning::ToString(u.state), u.reason, t_us);
       }
+    } else if (o_.task == Task::kWarehouse && !WarehouseStep(pose, t_us)) {
+      return;
     }
     if (Recovering(t_us)) return;
     const motion::VelocityCommand c = controller_.Update(Predict(pose), dt);
     Send(c.v_m_s, c.w_rad_s, t_us);
     last_command_ = c;
-    if (controller_.arrived() && (o_.task == Task::kWaypoints || explored_)) Settle(pose, t_us);
+    std::string how;
+    if (final_leg_ && controller_.arrived() && Settled(pose, t_us, &how)) Arrived(how, t_us);
   }
 
   MissionOptions o_;
@@ -260,9 +385,18 @@ class MissionStage : public Stage {
   std::shared_ptr<const mapping::OccupancyGrid> map_;
   bool started_ = false;
   bool explored_ = false;  // the explorer is done; the controller finishes at home
+  bool final_leg_ = false;  // the path ends at goal_, where the robot must stop within the tolerances
+  Pose2D goal_;
+  drivers::Status slam_status_;
+  // Warehouse.
+  std::vector<warehouse::Stop> stops_;
+  size_t stop_index_ = 0;
+  planning::AStarPlanner planner_;
+  bool need_plan_ = true;
+  int64_t dwell_until_us_ = -1, localized_us_ = -1;
   std::string state_ = "initializing", detail_;
   long long commands_ = 0, paths_ = 0, stale_stops_ = 0;
-  int corrections_ = 0, recoveries_ = 0;
+  int corrections_ = 0, total_corrections_ = 0, recoveries_ = 0, stalls_this_goal_ = 0;
   motion::VelocityCommand last_command_;
   int64_t stuck_since_us_ = -1, backoff_until_us_ = 0;
 };
@@ -275,10 +409,10 @@ StageType MissionStageType() {
           "driving the motion controller; emits velocity commands, paths and states",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             MissionOptions o;
-            o.task = s.GetChoice("task", "waypoints", {"waypoints", "explore"},
-                                 "follow a circuit of waypoints, or explore the unknown and return home") == "explore"
-                         ? Task::kExplore
-                         : Task::kWaypoints;
+            const std::string task = s.GetChoice("task", "waypoints", {"waypoints", "explore", "warehouse"},
+                                                 "follow a circuit of waypoints, explore the unknown and return home, or make "
+                                                 "the Warehouse's deliveries in the known map (the arena's targets and drop-offs)");
+            o.task = task == "explore" ? Task::kExplore : task == "warehouse" ? Task::kWarehouse : Task::kWaypoints;
             const std::vector<std::string> w =
                 s.GetList("waypoints", {"arena"},
                           "the circuit: 'arena' (the simulated arena's waypoint poses, relative to its start pose) or "
@@ -319,8 +453,13 @@ StageType MissionStageType() {
             o.max_corrections = static_cast<int>(s.GetInt("max_corrections", o.max_corrections,
                                                           "times the final pose is driven to again when the robot stopped outside the tolerances", 0, 100));
             o.stuck_s = s.GetDouble("stuck_s", o.stuck_s, "commanded to move but stalled this long: back off [s]", 0.1, 60.0);
+            o.max_stalls = static_cast<int>(s.GetInt("max_stalls", o.max_stalls, "stalls on the way to one goal before the mission fails", 0, 100000));
             o.backoff_s = s.GetDouble("backoff_s", o.backoff_s, "how long to reverse at 0.1 m/s when stalled [s]", 0.0, 10.0);
+            o.dwell_s = s.GetDouble("dwell_s", o.dwell_s, "warehouse: how long to stand at a target or drop-off [s] (the rules ask " +
+                                    Num(warehouse::kDwellS, 3) + " s)", 0.0, 600.0);
             o.status_channel = s.GetString("status_channel", o.status_channel, "channel of the status events");
+            o.slam_status_channel = s.GetString("slam_status_channel", o.slam_status_channel,
+                                                "channel of SLAM's status (warehouse: drive only once it says localized)");
             return std::make_unique<MissionStage>(o);
           }};
 }

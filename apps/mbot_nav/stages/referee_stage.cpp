@@ -3,7 +3,9 @@
 // the stack produced — its SLAM map and poses, its paths, its mission states. It ends the run when
 // the mission completes or fails, or at the event's time limit. Writes score.json, the trajectories
 // (true, SLAM) as TUM, the final map (.map + PNG with the planned, driven and true paths) and prints
-// the score table.
+// the score table. Events: speed_run and maze_explorer (SLAM from the start pose: the map frame is
+// the start frame), warehouse (localization in the given map: the map frame is the world frame;
+// deliveries judged from the true pose against warehouse.hpp's rules).
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -16,6 +18,7 @@
 #include "mbot/drivers/sim_world.hpp"
 #include "report.hpp"
 #include "stages.hpp"
+#include "warehouse.hpp"
 
 namespace mbot::app {
 namespace {
@@ -25,9 +28,21 @@ using motion::Pose2D;
 using motion::TimedPose;
 
 struct RefereeOptions {
-  std::string event = "speed_run";  // speed_run | maze_explorer
+  std::string event = "speed_run";  // speed_run | maze_explorer | warehouse
   double time_limit_s = 180.0;
   double finish_delay_s = 0.5;      // keep simulating this long after completion (the robot stops)
+  std::string mission_status_channel = "MISSION_STATUS";
+  std::string slam_status_channel = "SLAM_STATUS";
+};
+
+const char* EventTitle(const std::string& event) {
+  return event == "speed_run" ? "Speed Run" : event == "maze_explorer" ? "Maze Explorer" : event == "warehouse" ? "Warehouse" : "?";
+}
+
+// One line of the rubric: what was judged, how it went, the points.
+struct Item {
+  std::string name, detail;
+  int points = 0, max = 100;
 };
 
 // Points for a final pose error, the rubric's tiers (x, y in m; θ in degrees).
@@ -57,6 +72,7 @@ class RefereeStage : public Stage {
   void Start(const RunContext& ctx) override {
     bus_ = ctx.bus;
     world_ = drivers::World::Load(ctx.source_path);
+    if (o_.event == "warehouse") stops_ = warehouse::Stops(world_, ctx.seed);
     wall0_ = std::chrono::steady_clock::now();
   }
 
@@ -66,6 +82,7 @@ class RefereeStage : public Stage {
     switch (ev.kind) {
       case EventKind::kGroundTruth:
         truth_.push_back({ev.t_us, std::get<Pose2D>(ev.payload)});
+        if (!stops_.empty()) JudgeStop(truth_.back());
         break;
       case EventKind::kCollision:
         ++collisions_;
@@ -81,8 +98,12 @@ class RefereeStage : public Stage {
         break;
       case EventKind::kStatus: {
         const auto& s = std::get<drivers::Status>(ev.payload);
-        state_ = s.state, detail_ = s.detail;
-        if ((s.state == "completed" || s.state == "failed") && end_us_ < 0) end_us_ = ev.t_us;
+        if (ev.channel == o_.slam_status_channel) {
+          if (s.state == "localized" && localized_us_ < 0) localized_us_ = ev.t_us;
+        } else if (ev.channel == o_.mission_status_channel) {
+          state_ = s.state, detail_ = s.detail;
+          if ((s.state == "completed" || s.state == "failed") && end_us_ < 0) end_us_ = ev.t_us;
+        }
         break;
       }
       default:
@@ -106,34 +127,82 @@ class RefereeStage : public Stage {
       mbot::log::Warn("referee: no ground truth in the stream (is the source the simulator?); nothing scored");
       return;
     }
+    const bool warehouse = o_.event == "warehouse";
     const Pose2D start = truth_.front().pose, final_pose = truth_.back().pose;
+    // Where the map frame lies in the world: SLAM began at the origin at the start pose, or the map
+    // was given in the world frame (the Warehouse).
+    const Pose2D frame = warehouse ? Pose2D{} : start;
+    const bool completed = state_ == "completed";
+    const double time_s = end_us_ >= 0 ? (end_us_ - t0_us_) * 1e-6 : sim_s;
+    const double rtf = wall_s > 0 ? sim_s / wall_s : 0.0;
+    // Final pose against the start (the robot had to come back), and SLAM's own error at its last pose.
     const double ex = std::abs(final_pose.x - start.x), ey = std::abs(final_pose.y - start.y);
     const double eth = std::abs(motion::WrapAngle(final_pose.theta - start.theta)) * 180.0 / M_PI;
-    const bool completed = state_ == "completed";
-    const int pose_points = completed ? PosePoints(ex, ey, eth) : 0;
-    const double time_s = end_us_ >= 0 ? (end_us_ - t0_us_) * 1e-6 : sim_s;
-    const MapQuality mq = map_ ? Quality(*map_, start) : MapQuality{};
-    const int map_points = static_cast<int>(std::floor(100.0 * std::min(1.0, std::min(mq.coverage / 0.99, mq.precision / 0.95))));
-    int time_points = 0, autonomy_points = 0;
-    if (o_.event == "speed_run") time_points = completed ? LapPoints(time_s) : 0;
-    if (o_.event == "maze_explorer") autonomy_points = completed ? 100 : 0;  // no human touched it
-    const int total = pose_points + map_points + time_points + autonomy_points;
-    const double rtf = wall_s > 0 ? sim_s / wall_s : 0.0;
+    bool has_slam_error = false;
+    double sx = 0, sy = 0, sth = 0;
+    if (!slam_.empty()) {
+      Pose2D truth_then;
+      if (motion::InterpolateAt(truth_, slam_.back().t_us, 200'000, &truth_then)) {
+        const Pose2D est = frame.Compose(slam_.back().pose);
+        has_slam_error = true;
+        sx = std::abs(est.x - truth_then.x), sy = std::abs(est.y - truth_then.y);
+        sth = std::abs(motion::WrapAngle(est.theta - truth_then.theta)) * 180.0 / M_PI;
+      }
+    }
+    auto errors = [](double x, double y, double th) {
+      char b[80];
+      std::snprintf(b, sizeof b, "%.3f / %.3f m, %.1f deg", x, y, th);
+      return std::string(b);
+    };
+
+    std::vector<Item> items;
+    MapQuality mq;
+    if (!warehouse) {
+      items.push_back({"final pose", errors(ex, ey, eth) + " from the start" + (completed ? "" : " (not completed)"),
+                       completed ? PosePoints(ex, ey, eth) : 0});
+      mq = map_ ? Quality(*map_, start) : MapQuality{};
+      items.push_back({"map quality", "coverage " + Num(100 * mq.coverage, 3) + " %, walls " + Num(100 * mq.precision, 3) +
+                                          " % within 1.5 cells",
+                       static_cast<int>(std::floor(100.0 * std::min(1.0, std::min(mq.coverage / 0.99, mq.precision / 0.95))))});
+      if (o_.event == "speed_run") items.push_back({"lap time", Num(time_s, 4) + " s", completed ? LapPoints(time_s) : 0});
+      if (o_.event == "maze_explorer") {
+        items.push_back({"autonomy", completed ? "explored and home, no help" : "not completed", completed ? 100 : 0});
+      }
+    } else {
+      const bool localized = localized_us_ >= 0;
+      items.push_back({"localization",
+                       localized ? "settled in " + Num((localized_us_ - t0_us_) * 1e-6, 3) + " s; at the end SLAM off by " +
+                                       errors(sx, sy, sth)
+                                 : "global localization never settled",
+                       localized && has_slam_error ? PosePoints(sx, sy, sth) : 0});
+      int needed = 0;
+      for (size_t l = 0; l < warehouse::Levels().size(); ++l) {
+        const warehouse::Level& level = warehouse::Levels()[l];
+        needed += level.deliveries;
+        const size_t last_stop = static_cast<size_t>(2 * needed - 1);  // the drop-off of the level's last delivery
+        const int made = static_cast<int>(done_at_us_.size() / 2);
+        const bool done = done_at_us_.size() > last_stop;
+        const double at_s = done ? (done_at_us_[last_stop] - t0_us_) * 1e-6 : 0.0;
+        const bool in_time = done && at_s <= level.deadline_s;
+        items.push_back({"level " + std::to_string(l + 1),
+                         done ? std::to_string(needed) + (needed == 1 ? " delivery by " : " deliveries by ") + Num(at_s, 4) + " s (limit " + Num(level.deadline_s, 4) + " s)"
+                              : std::to_string(std::min(made, needed)) + " of " + std::to_string(needed) + " deliveries",
+                         in_time ? 100 : 0});
+        if (in_time && levels_reached_ == static_cast<int>(l)) levels_reached_ = static_cast<int>(l) + 1;
+      }
+    }
+    int total = 0, max_total = 0;
+    for (const Item& i : items) total += i.points, max_total += i.max;
 
     std::ostringstream t;
-    t << "\n" << std::left << std::setw(15) << "event" << std::setw(18) << "arena" << std::setw(6) << "seed" << std::setw(11)
-      << "result" << std::right << std::setw(8) << "time s" << std::setw(22) << "final err x/y m, deg" << std::setw(6) << "pose"
-      << std::setw(9) << "map cov" << std::setw(6) << "map" << std::setw(6) << "time" << std::setw(6) << "auto" << std::setw(7)
-      << "total" << std::setw(6) << "hits" << std::setw(7) << "RTF" << "\n";
-    char err[64];
-    std::snprintf(err, sizeof err, "%.3f/%.3f/%.1f", ex, ey, eth);
-    t << std::left << std::setw(15) << o_.event << std::setw(18) << world_.name().substr(0, 17) << std::setw(6) << ctx.seed
-      << std::setw(11) << (timed_out_ ? "time limit" : state_) << std::right << std::fixed << std::setprecision(1) << std::setw(8)
-      << time_s << std::setw(22) << err << std::setw(6) << pose_points << std::setw(8) << std::setprecision(1)
-      << 100 * mq.coverage << "%" << std::setw(6) << map_points << std::setw(6) << time_points << std::setw(6)
-      << autonomy_points << std::setw(7) << total << std::setw(6) << collisions_ << std::setw(6) << std::setprecision(0)
-      << rtf << "x\n";
-    t << "(Heavy Lift needs the forklift and AprilTag vision: not run. Warehouse: not yet in this build.)\n";
+    const std::string result = timed_out_ ? "time limit" : state_;
+    t << "\n" << EventTitle(o_.event) << " - arena " << world_.name() << ", seed " << ctx.seed << ": " << result << " after "
+      << Num(time_s, 4) << " s (" << Num(rtf, 3) << "x real time), " << collisions_ << " collisions\n";
+    for (const Item& i : items) {
+      t << "  " << std::left << std::setw(14) << i.name << std::setw(74) << i.detail << std::right << std::setw(4) << i.points
+        << " / " << i.max << "\n";
+    }
+    t << "  " << std::left << std::setw(88) << "total" << std::right << std::setw(4) << total << " / " << max_total << "\n";
     std::cout << t.str() << std::flush;
 
     std::ostringstream j;
@@ -144,27 +213,50 @@ class RefereeStage : public Stage {
       << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"time_s\": " << Num(time_s)
       << ",\n  \"sim_seconds\": " << Num(sim_s) << ",\n  \"wall_seconds\": " << Num(wall_s) << ",\n  \"real_time_factor\": " << Num(rtf)
       << ",\n  \"collisions\": " << collisions_ << ",\n  \"start\": " << PoseJson(start) << ",\n  \"final\": " << PoseJson(final_pose)
-      << ",\n  \"final_error\": {\"x_m\": " << Num(ex) << ", \"y_m\": " << Num(ey) << ", \"theta_deg\": " << Num(eth) << "}"
-      << ",\n  \"map\": {\"coverage\": " << Num(mq.coverage) << ", \"wall_precision\": " << Num(mq.precision)
-      << ", \"reachable_cells\": " << mq.reachable_cells << ", \"occupied_cells\": " << mq.occupied_cells << "}"
-      << ",\n  \"points\": {\"pose\": " << pose_points << ", \"map\": " << map_points << ", \"time\": " << time_points
-      << ", \"autonomy\": " << autonomy_points << ", \"total\": " << total << "}\n}\n";
+      << ",\n  \"final_error\": {\"x_m\": " << Num(ex) << ", \"y_m\": " << Num(ey) << ", \"theta_deg\": " << Num(eth) << "}";
+    if (has_slam_error) {
+      j << ",\n  \"slam_final_error\": {\"x_m\": " << Num(sx) << ", \"y_m\": " << Num(sy) << ", \"theta_deg\": " << Num(sth) << "}";
+    }
+    if (!warehouse) {
+      j << ",\n  \"map\": {\"coverage\": " << Num(mq.coverage) << ", \"wall_precision\": " << Num(mq.precision)
+        << ", \"reachable_cells\": " << mq.reachable_cells << ", \"occupied_cells\": " << mq.occupied_cells << "}";
+    } else {
+      j << ",\n  \"localized_at_s\": " << (localized_us_ >= 0 ? Num((localized_us_ - t0_us_) * 1e-6) : "null")
+        << ",\n  \"levels_reached\": " << levels_reached_ << ",\n  \"stops\": [";
+      for (size_t k = 0; k < stops_.size(); ++k) {
+        j << (k ? "," : "") << "\n    {\"stop\": " << JsonString(stops_[k].Name()) << ", \"pose\": " << PoseJson(stops_[k].pose)
+          << ", \"done_at_s\": " << (k < done_at_us_.size() ? Num((done_at_us_[k] - t0_us_) * 1e-6) : "null") << "}";
+      }
+      j << "\n  ]";
+    }
+    j << ",\n  \"points\": {";
+    for (const Item& i : items) j << JsonString(i.name) << ": " << i.points << ", ";
+    j << "\"total\": " << total << ", \"max\": " << max_total << "}\n}\n";
+
     const std::string dir = ctx.output_dir;
     WriteTum(dir + "/true_path.tum", truth_, Pose2D{});
-    WriteTum(dir + "/slam_path.tum", slam_, start);
+    WriteTum(dir + "/slam_path.tum", slam_, frame);
     if (map_) {
       drivers::WriteBotlabMap(*map_, dir + "/final_map.map");
       std::vector<drivers::MapOverlay> overlays;
-      std::vector<Pose2D> driven, truth;
+      std::vector<Pose2D> driven, truth, stops;
       for (const auto& p : slam_) driven.push_back(p.pose);
-      const Pose2D inv = start.Inverse();
+      const Pose2D inv = frame.Inverse();
       for (size_t i = 0; i < truth_.size(); i += 5) truth.push_back(inv.Compose(truth_[i].pose));
+      for (const warehouse::Stop& st : stops_) stops.push_back(inv.Compose(st.pose));
       overlays.push_back({truth, 0, 0, 0, false, "true path"});
       overlays.push_back({driven, 31, 119, 180, false, "SLAM path"});
       if (!path_.empty()) overlays.push_back({path_, 214, 39, 40, false, "last planned path"});
+      if (!stops.empty()) overlays.push_back({stops, 44, 160, 44, true, "targets and drop-offs"});
       drivers::WriteMapPngWithOverlays(*map_, overlays, 4, dir + "/final_map.png");
     }
     WriteFileAtomically(dir + "/score.json", [&](std::ostream& out) { out << j.str(); });
+    if (ctx.results) {
+      *ctx.results = {{"event", EventTitle(o_.event)}, {"arena", world_.name()}, {"seed", std::to_string(ctx.seed)},
+                      {"result", result}, {"time_s", Num(time_s, 4)}, {"points", std::to_string(total)},
+                      {"max_points", std::to_string(max_total)}, {"collisions", std::to_string(collisions_)},
+                      {"real_time_factor", Num(rtf, 3)}};
+    }
   }
 
  private:
@@ -214,6 +306,26 @@ class RefereeStage : public Stage {
     });
   }
 
+  // Warehouse: the next stop counts when the true pose has stayed within the tolerances of it for
+  // the dwell time (stops count in order; a stop the robot skipped holds up the ones after it).
+  void JudgeStop(const TimedPose& truth) {
+    if (done_at_us_.size() >= stops_.size()) return;
+    const Pose2D& goal = stops_[done_at_us_.size()].pose;
+    const bool near = std::hypot(truth.pose.x - goal.x, truth.pose.y - goal.y) <= warehouse::kToleranceM &&
+                      std::abs(motion::WrapAngle(truth.pose.theta - goal.theta)) * 180.0 / M_PI <= warehouse::kToleranceDeg;
+    if (!near) {
+      near_since_us_ = -1;
+      return;
+    }
+    if (near_since_us_ < 0) near_since_us_ = truth.t_us;
+    if ((truth.t_us - near_since_us_) * 1e-6 >= warehouse::kDwellS) {
+      done_at_us_.push_back(truth.t_us);
+      near_since_us_ = -1;
+      mbot::log::Info("referee: " + stops_[done_at_us_.size() - 1].Name() + " done at " +
+                      Num((truth.t_us - t0_us_) * 1e-6, 4) + " s");
+    }
+  }
+
   RefereeOptions o_;
   Bus* bus_ = nullptr;
   drivers::World world_;
@@ -225,6 +337,12 @@ class RefereeStage : public Stage {
   std::string state_ = "initializing", detail_;
   int collisions_ = 0;
   bool stop_sent_ = false, timed_out_ = false;
+  int64_t localized_us_ = -1;
+  // Warehouse.
+  std::vector<warehouse::Stop> stops_;
+  std::vector<int64_t> done_at_us_;  // when each stop was done, in order
+  int64_t near_since_us_ = -1;
+  int levels_reached_ = 0;
 };
 
 }  // namespace
@@ -235,9 +353,11 @@ StageType RefereeStageType() {
           "the mission finishes or time runs out, writes score.json, trajectories and the final map",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             RefereeOptions o;
-            o.event = s.GetChoice("event", o.event, {"speed_run", "maze_explorer"}, "which event is scored");
+            o.event = s.GetChoice("event", o.event, {"speed_run", "maze_explorer", "warehouse"}, "which event is scored");
             o.time_limit_s = s.GetDouble("time_limit_s", o.time_limit_s, "the run ends here if the mission has not [s]", 1.0, 1e5);
             o.finish_delay_s = s.GetDouble("finish_delay_s", o.finish_delay_s, "simulate this long after the mission ends [s]", 0.0, 60.0);
+            o.mission_status_channel = s.GetString("mission_status_channel", o.mission_status_channel, "channel of the mission's states");
+            o.slam_status_channel = s.GetString("slam_status_channel", o.slam_status_channel, "channel of SLAM's states");
             return std::make_unique<RefereeStage>(o);
           }};
 }

@@ -37,10 +37,6 @@ std::string ShortestDouble(double v) {
 
 [[noreturn]] void Fail(const std::string& path, const std::string& why) { throw std::runtime_error(path + ": " + why); }
 
-bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 }  // namespace
 
 mapping::OccupancyGrid ReadBotlabMap(const std::string& path) {

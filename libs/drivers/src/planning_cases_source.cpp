@@ -13,10 +13,6 @@ namespace mbot::drivers {
 namespace fs = std::filesystem;
 namespace {
 
-bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 [[noreturn]] void Fail(const std::string& path, int line, const std::string& what) {
   throw std::runtime_error(path + (line > 0 ? ":" + std::to_string(line) : std::string()) + ": " + what);
 }

@@ -10,6 +10,13 @@ namespace {
 
 motion::Pose2D StartPose(const SourceOptions& options, const World& world) {
   if (options.sim.start) return *options.sim.start;
+  if (options.sim.random_start) {
+    try {
+      return RandomFreePose(world, options.sim.random_start_clearance_m, options.seed);
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(options.path + ": start = random: " + e.what());
+    }
+  }
   const std::vector<motion::Pose2D> starts = world.PosesLabelled("start");
   if (starts.empty()) {
     throw std::runtime_error(options.path + ": the world has no 'start' pose; set [source] start = x, y, theta_deg");

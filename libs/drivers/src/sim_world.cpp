@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <random>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -592,6 +593,63 @@ std::vector<uint8_t> ReachableFreeMask(const World& world, const motion::Pose2D&
     }
   }
   return mask;
+}
+
+namespace {
+
+// The world's reachable free space as a mask over its true map (every free cell without a start).
+std::vector<uint8_t> ReachableFromStart(const World& world) {
+  const std::vector<motion::Pose2D> starts = world.PosesLabelled("start");
+  if (!starts.empty()) return ReachableFreeMask(world, starts.front());
+  std::vector<uint8_t> mask(world.truth().cells().size());
+  for (size_t i = 0; i < mask.size(); ++i) mask[i] = world.truth().cells()[i] < 0;
+  return mask;
+}
+
+}  // namespace
+
+mapping::OccupancyGrid RenderKnownMap(const World& world, double resolution_m) {
+  if (!(resolution_m > 0)) throw std::invalid_argument("RenderKnownMap: resolution must be positive");
+  const mapping::OccupancyGrid& t = world.truth();
+  const std::vector<uint8_t> reach = ReachableFromStart(world);
+  const double w = t.width() * t.resolution(), h = t.height() * t.resolution();
+  const int nx = static_cast<int>(std::ceil(w / resolution_m)), ny = static_cast<int>(std::ceil(h / resolution_m));
+  mapping::OccupancyGrid m(nx, ny, resolution_m, t.origin_x(), t.origin_y());
+  for (int cy = 0; cy < ny; ++cy) {
+    for (int cx = 0; cx < nx; ++cx) {
+      double x, y;
+      m.CellToWorld(cx, cy, &x, &y);
+      // Occupied when a wall comes within half a cell side of the centre (what a mapped wall looks
+      // like; half a diagonal would also take cells a wall merely grazes, fattening every wall).
+      if (world.ClearanceAt(x, y) <= 0.5 * resolution_m) {
+        m.at(cx, cy) = 127;
+        continue;
+      }
+      int tx, ty;
+      t.WorldToCell(x, y, &tx, &ty);
+      if (t.IsInside(tx, ty) && reach[static_cast<size_t>(ty) * t.width() + tx]) m.at(cx, cy) = -127;
+    }
+  }
+  return m;
+}
+
+motion::Pose2D RandomFreePose(const World& world, double clearance_m, uint64_t seed) {
+  const mapping::OccupancyGrid& t = world.truth();
+  const std::vector<uint8_t> reach = ReachableFromStart(world);
+  std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ULL + 0x5157A27);
+  std::uniform_real_distribution<double> ux(t.origin_x(), t.origin_x() + t.width() * t.resolution());
+  std::uniform_real_distribution<double> uy(t.origin_y(), t.origin_y() + t.height() * t.resolution());
+  std::uniform_real_distribution<double> uth(-M_PI, M_PI);
+  for (int i = 0; i < 10'000; ++i) {
+    const double x = ux(rng), y = uy(rng);
+    int cx, cy;
+    t.WorldToCell(x, y, &cx, &cy);
+    if (!t.IsInside(cx, cy) || !reach[static_cast<size_t>(cy) * t.width() + cx]) continue;
+    if (world.ClearanceAt(x, y) < clearance_m) continue;
+    return {x, y, uth(rng)};
+  }
+  throw std::runtime_error("RandomFreePose: no place in '" + world.name() + "' keeps " + Num(clearance_m) +
+                           " m from every wall (10,000 draws)");
 }
 
 }  // namespace mbot::drivers

@@ -1,3 +1,4 @@
+#include "mbot/common/strings.hpp"
 #include "mbot/drivers/source_options.hpp"
 
 #include <zlib.h>
@@ -43,10 +44,6 @@ class MapSource : public Source {
   bool done_ = false;
 };
 
-bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 // "x, y, theta_deg" → a pose (theta in radians).
 motion::Pose2D ParsePoseKey(config::Section& s, const std::string& key, const std::vector<std::string>& items) {
   if (items.size() != 3) {
@@ -68,9 +65,14 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& wo
   const auto doc = [](const char* text) { return std::string("simulator: ") + text; };
   SimSourceOptions o;
   const std::vector<std::string> start =
-      s.GetList("start", {}, doc("where the robot starts, in the world frame: x [m], y [m], theta [deg]; "
-                                 "default: the arena's 'start' pose (required for a map world)"));
-  if (!start.empty()) {
+      s.GetList("start", {}, doc("where the robot starts, in the world frame: x [m], y [m], theta [deg], or 'random' "
+                                 "(a seeded draw from the reachable free space); default: the arena's 'start' pose "
+                                 "(required for a map world)"));
+  o.random_start_clearance_m = s.GetDouble("random_start_clearance_m", o.random_start_clearance_m,
+                                           doc("start = random keeps this far from every wall [m]"), 0.0, 10.0);
+  if (start.size() == 1 && start[0] == "random") {
+    o.random_start = true;
+  } else if (!start.empty()) {
     o.start = ParsePoseKey(s, "start", start);
   } else if (!s.describing() && !EndsWith(world_path, ".arena")) {
     s.Fail("start", "required: the world '" + world_path + "' is a map, which names no start pose");

@@ -18,6 +18,10 @@ struct SimSourceOptions {
   // World frame. Unset: the world file's `start` pose (an `.arena` file's `pose start …` line);
   // a grid world has none, so it must be given.
   std::optional<motion::Pose2D> start;
+  // `start = random`: a pose drawn from the reachable free space keeping random_start_clearance_m
+  // from the walls (RandomFreePose), from the pipeline's seed — the Warehouse's random start.
+  bool random_start = false;
+  double random_start_clearance_m = 0.25;
   double duration_s = 600.0;  // simulated time after which the stream ends
   SimRobotOptions robot;
 };

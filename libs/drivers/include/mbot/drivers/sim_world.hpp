@@ -92,4 +92,15 @@ class World {
 // exploration run is scored. Throws when the start is not in a free cell.
 std::vector<uint8_t> ReachableFreeMask(const World& world, const motion::Pose2D& start);
 
+// The world as a known map at `resolution_m` (a competition's given map, e.g. the Warehouse's):
+// cells that a wall overlaps are occupied (+127), cells of the reachable free space (from the world's
+// `start` pose, or every free cell of a world without one) free (-127), everything else unknown.
+// The map's frame is the world frame.
+mapping::OccupancyGrid RenderKnownMap(const World& world, double resolution_m);
+
+// A pose drawn uniformly from the free space reachable from the world's `start` pose (any free
+// space when it has none) that keeps `clearance_m` from every wall, heading uniform; the same seed
+// gives the same pose. Throws when 10,000 draws find no such place.
+motion::Pose2D RandomFreePose(const World& world, double clearance_m, uint64_t seed);
+
 }  // namespace mbot::drivers

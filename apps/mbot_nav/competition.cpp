@@ -1,0 +1,160 @@
+#include "competition.hpp"
+
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+#include <set>
+#include <sstream>
+
+#include "mbot/common/atomic_file.hpp"
+#include "mbot/common/log.hpp"
+#include "stages/report.hpp"
+
+namespace mbot::app {
+namespace {
+
+std::string Value(const std::vector<std::pair<std::string, std::string>>& kv, const std::string& key) {
+  for (const auto& [k, v] : kv) {
+    if (k == key) return v;
+  }
+  return "";
+}
+
+struct Row {
+  std::string name, event, arena, seed, result, time_s, points, max_points, collisions, rtf, outputs;
+};
+
+}  // namespace
+
+bool IsCompetition(const config::Config& config) { return config.HasSection("competition"); }
+
+CompetitionPlan BuildCompetition(const config::Config& config) {
+  CompetitionPlan plan;
+  config::Section c = config.GetSection("competition");
+  const std::vector<std::string> events = c.GetList("events", {}, "the event sections to run, in order");
+  if (events.empty() && !c.describing()) c.Fail("events", "names no event");
+  const long long seed = c.GetInt("seed", 1, "the seed every event runs with (an event's own seed key wins)", 0);
+  plan.not_run = c.GetList("not_run", {}, "events listed in the table as not run, as 'Event: why'");
+  c.Finish();
+  {
+    config::Section o = config.GetSection("output");
+    plan.output_dir = o.GetPath("dir", "out/competition", "each event writes to dir/<event>; the table to dir/competition.json");
+    o.Finish();
+  }
+  std::set<std::string> used = {"competition", "output"};
+  for (const std::string& name : events) {
+    if (!used.insert(name).second) c.Fail("events", "'" + name + "' is listed twice or is a reserved section");
+    if (!config.HasSection(name)) c.Fail("events", "event '" + name + "' has no [" + name + "] section");
+  }
+  for (const std::string& name : config.SectionNames()) {
+    if (!used.count(name)) {
+      throw config::ConfigError(config.SectionOrigin(name).ToString() + ": [" + name +
+                                "] is not used (not an event listed in [competition] events, and not competition/output)");
+    }
+  }
+  for (const std::string& name : events) {
+    config::Section e = config.GetSection(name);
+    const std::string path = e.RequirePath("config", "the event's own configuration (an INI a single run takes)");
+    const std::string world = e.GetPath("world", "", "another world for the event (its [source] path: an arena or a map)");
+    const long long event_seed = e.GetInt("seed", seed, "this event's seed", 0);
+    const std::vector<std::string> sets = e.GetList("set", {}, "section.key=value overrides of the event's configuration");
+    e.Finish();
+    config::Config event;
+    try {
+      event = config::Config::Load(path);
+    } catch (const config::ConfigError& err) {
+      e.Fail("config", err.what());
+    }
+    try {
+      event.Set("pipeline.seed=" + std::to_string(event_seed));
+      event.Set("pipeline.progress=off");  // the events are short; the table is the report
+      event.Set("output.dir=" + plan.output_dir + "/" + name);
+      if (!world.empty()) event.Set("source.path=" + world);
+      for (const std::string& s : sets) event.Set(s);
+    } catch (const config::ConfigError& err) {
+      e.Fail("set", err.what());
+    }
+    plan.events.push_back({name, BuildPlan(event)});
+  }
+  return plan;
+}
+
+int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
+  std::vector<Row> rows;
+  int status = 0;
+  for (CompetitionEvent& e : plan.events) {
+    Row r;
+    r.name = e.name;
+    r.outputs = e.plan.output.dir;
+    if (stop.load()) {
+      r.result = "not run: interrupted";
+      rows.push_back(r);
+      continue;
+    }
+    mbot::log::Info("competition: " + e.name + " (seed " + std::to_string(e.plan.pipeline.seed) + ", world " +
+                    e.plan.source.path + ")");
+    try {
+      const RunSummary s = RunPlan(e.plan, stop);
+      r.event = Value(s.results, "event");
+      r.arena = Value(s.results, "arena");
+      r.seed = Value(s.results, "seed");
+      r.result = s.interrupted ? "interrupted" : Value(s.results, "result");
+      r.time_s = Value(s.results, "time_s");
+      r.points = Value(s.results, "points");
+      r.max_points = Value(s.results, "max_points");
+      r.collisions = Value(s.results, "collisions");
+      r.rtf = Value(s.results, "real_time_factor");
+      if (r.points.empty()) r.result = "not scored (no referee stage in " + e.name + ")";
+      if (s.interrupted) status = 130;
+    } catch (const std::exception& ex) {
+      mbot::log::Error("competition: " + e.name + ": " + ex.what());
+      r.result = std::string("error: ") + ex.what();
+      status = status ? status : 1;
+    }
+    rows.push_back(r);
+  }
+
+  int total = 0, max_total = 0;
+  std::ostringstream t;
+  t << "\nCompetition on the simulator (Winter 2024 rules)\n"
+    << std::left << std::setw(15) << "event" << std::setw(22) << "arena" << std::setw(6) << "seed" << std::setw(12) << "result"
+    << std::right << std::setw(8) << "time s" << std::setw(11) << "points" << std::setw(6) << "hits" << std::setw(7) << "RTF" << "\n";
+  for (const Row& r : rows) {
+    if (r.points.empty()) {
+      t << std::left << std::setw(15) << (r.event.empty() ? r.name : r.event) << r.result << "\n";
+      continue;
+    }
+    total += std::stoi(r.points), max_total += std::stoi(r.max_points);
+    t << std::left << std::setw(15) << r.event << std::setw(22) << r.arena.substr(0, 21) << std::setw(6) << r.seed << std::setw(12)
+      << r.result.substr(0, 11) << std::right << std::setw(8) << r.time_s << std::setw(11) << (r.points + " / " + r.max_points)
+      << std::setw(6) << r.collisions << std::setw(6) << r.rtf << "x\n";
+  }
+  for (const std::string& n : plan.not_run) {
+    const auto colon = n.find(':');
+    t << std::left << std::setw(15) << n.substr(0, colon) << "not run"
+      << (colon == std::string::npos ? "" : ":" + n.substr(colon + 1)) << "\n";
+  }
+  t << std::left << std::setw(63) << "total" << std::right << std::setw(11) << (std::to_string(total) + " / " + std::to_string(max_total))
+    << "\n";
+  std::cout << t.str() << std::flush;
+
+  std::ostringstream j;
+  j << "{\n  \"events\": [";
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const Row& r = rows[i];
+    auto num = [](const std::string& v) { return v.empty() ? std::string("null") : v; };
+    j << (i ? "," : "") << "\n    {\"section\": " << JsonString(r.name) << ", \"event\": " << JsonString(r.event)
+      << ", \"arena\": " << JsonString(r.arena) << ", \"seed\": " << num(r.seed) << ", \"result\": " << JsonString(r.result)
+      << ", \"time_s\": " << num(r.time_s) << ", \"points\": " << num(r.points) << ", \"max_points\": " << num(r.max_points)
+      << ", \"collisions\": " << num(r.collisions) << ", \"real_time_factor\": " << num(r.rtf)
+      << ", \"outputs\": " << JsonString(r.outputs) << "}";
+  }
+  j << "\n  ],\n  \"not_run\": [";
+  for (size_t i = 0; i < plan.not_run.size(); ++i) j << (i ? ", " : "") << JsonString(plan.not_run[i]);
+  j << "],\n  \"points\": " << total << ",\n  \"max_points\": " << max_total << "\n}\n";
+  EnsureDirectory(plan.output_dir);
+  WriteFileAtomically(plan.output_dir + "/competition.json", [&](std::ostream& out) { out << j.str(); });
+  return status;
+}
+
+}  // namespace mbot::app
