@@ -30,7 +30,6 @@ using motion::TimedPose;
 
 enum class Task { kWaypoints, kExplore, kWarehouse };
 
-constexpr double kEscapeM = 0.30;  // how far a robot inside the planning radius may step out first [m]
 
 const char* TaskName(Task t) { return t == Task::kWaypoints ? "waypoints" : t == Task::kExplore ? "explore" : "warehouse"; }
 
@@ -218,7 +217,7 @@ class MissionStage : public Stage {
     }
     if (need_plan_ && t_us >= backoff_until_us_) {
       const warehouse::Stop& stop = stops_[stop_index_];
-      const planning::PlanResult r = PlanFrom(pose, stop.pose);
+      const planning::PlanResult r = planner_.PlanSteppingOut(pose, stop.pose);
       if (r.status != planning::PlanStatus::kFound) {
         SetState("failed", "no path to " + stop.Name() + ": " + planning::ToString(r.status), t_us);
         Send(0, 0, t_us);
@@ -232,32 +231,6 @@ class MissionStage : public Stage {
       SetState("driving", "to " + stop.Name() + " of " + std::to_string(warehouse::TotalDeliveries()), t_us);
     }
     return true;
-  }
-
-  // A* from the pose to the goal. A robot closer to a wall than the planning radius (it was pushed,
-  // or localization was wrong for a while) first steps straight out to the nearest place that keeps
-  // the radius, when one within escape_m is reachable by a segment that keeps half of it.
-  planning::PlanResult PlanFrom(const Pose2D& pose, const Pose2D& goal) {
-    planning::PlanResult r = planner_.Plan(pose, goal);
-    if (r.status != planning::PlanStatus::kStartInCollision) return r;
-    const double radius = o_.exploration.astar.robot_radius_m, res = map_ ? map_->resolution() : 0.05;
-    for (double d = res; d <= kEscapeM; d += res) {
-      for (int k = 0; k < 32; ++k) {
-        const double a = pose.theta + k * M_PI / 16;
-        const Pose2D out{pose.x + d * std::cos(a), pose.y + d * std::sin(a), a};
-        if (planner_.DistanceAt(out.x, out.y) <= radius + 0.5 * res ||
-            !planner_.SegmentIsClear(pose.x, pose.y, out.x, out.y, 0.5 * radius)) {
-          continue;
-        }
-        planning::PlanResult rest = planner_.Plan(out, goal);
-        if (rest.status != planning::PlanStatus::kFound) continue;
-        rest.path.insert(rest.path.begin(), pose);
-        mbot::log::Info("mission: " + Num(planner_.DistanceAt(pose.x, pose.y), 3) + " m from a wall: stepping out " +
-                        Num(d, 3) + " m first");
-        return rest;
-      }
-    }
-    return r;
   }
 
   // The goal is reached and the robot stands at it.

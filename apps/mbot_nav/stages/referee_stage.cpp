@@ -238,6 +238,7 @@ class RefereeStage : public Stage {
     WriteTum(dir + "/slam_path.tum", slam_, frame);
     if (map_) {
       drivers::WriteBotlabMap(*map_, dir + "/final_map.map");
+      const mapping::OccupancyGrid picture = CropToKnown(*map_, 0.3);
       std::vector<drivers::MapOverlay> overlays;
       std::vector<Pose2D> driven, truth, stops;
       for (const auto& p : slam_) driven.push_back(p.pose);
@@ -248,7 +249,7 @@ class RefereeStage : public Stage {
       overlays.push_back({driven, 31, 119, 180, false, "SLAM path"});
       if (!path_.empty()) overlays.push_back({path_, 214, 39, 40, false, "last planned path"});
       if (!stops.empty()) overlays.push_back({stops, 44, 160, 44, true, "targets and drop-offs"});
-      drivers::WriteMapPngWithOverlays(*map_, overlays, 4, dir + "/final_map.png");
+      drivers::WriteMapPngWithOverlays(picture, overlays, 4, dir + "/final_map.png");
     }
     WriteFileAtomically(dir + "/score.json", [&](std::ostream& out) { out << j.str(); });
     if (ctx.results) {
@@ -294,6 +295,27 @@ class RefereeStage : public Stage {
     }
     q.precision = q.occupied_cells ? double(near_wall) / q.occupied_cells : 0.0;
     return q;
+  }
+
+  // The map's known cells and `margin_m` around them (SLAM's map starts large; the picture need not).
+  static mapping::OccupancyGrid CropToKnown(const mapping::OccupancyGrid& m, double margin_m) {
+    int x0 = m.width(), y0 = m.height(), x1 = -1, y1 = -1;
+    for (int cy = 0; cy < m.height(); ++cy) {
+      for (int cx = 0; cx < m.width(); ++cx) {
+        if (m.at(cx, cy) == 0) continue;
+        x0 = std::min(x0, cx), x1 = std::max(x1, cx), y0 = std::min(y0, cy), y1 = std::max(y1, cy);
+      }
+    }
+    if (x1 < 0) return m;
+    const int pad = static_cast<int>(std::ceil(margin_m / m.resolution()));
+    x0 = std::max(0, x0 - pad), y0 = std::max(0, y0 - pad);
+    x1 = std::min(m.width() - 1, x1 + pad), y1 = std::min(m.height() - 1, y1 + pad);
+    mapping::OccupancyGrid c(x1 - x0 + 1, y1 - y0 + 1, m.resolution(), m.origin_x() + x0 * m.resolution(),
+                             m.origin_y() + y0 * m.resolution());
+    for (int cy = y0; cy <= y1; ++cy) {
+      for (int cx = x0; cx <= x1; ++cx) c.at(cx - x0, cy - y0) = m.at(cx, cy);
+    }
+    return c;
   }
 
   static void WriteTum(const std::string& path, const std::vector<TimedPose>& poses, const Pose2D& frame) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <limits>
 #include <stdexcept>
 
@@ -308,6 +309,34 @@ std::vector<double> AStarPlanner::EasingClearances() const {
   }
   out.push_back(r);
   return out;
+}
+
+PlanResult AStarPlanner::PlanSteppingOut(const motion::Pose2D& start, const motion::Pose2D& goal, double max_step_m) {
+  if (!has_map()) throw std::logic_error("AStarPlanner::PlanSteppingOut without a map");
+  const double radius = options_.robot_radius_m;
+  if (DistanceAt(start.x, start.y) > radius) return Plan(start, goal);
+  // The nearest cell centre outside the radius that a straight step reaches keeping half of it.
+  const double res = impl_->resolution;
+  const int reach = static_cast<int>(std::ceil(max_step_m / res));
+  double best = std::numeric_limits<double>::infinity();
+  std::optional<motion::Pose2D> out;
+  int cx, cy;
+  if (impl_->ToCell(start.x, start.y, &cx, &cy)) {
+    for (int dy = -reach; dy <= reach; ++dy) {
+      for (int dx = -reach; dx <= reach; ++dx) {
+        const double x = impl_->origin_x + (cx + dx + 0.5) * res, y = impl_->origin_y + (cy + dy + 0.5) * res;
+        const double d = std::hypot(x - start.x, y - start.y);
+        if (d >= best || d > max_step_m || DistanceAt(x, y) <= radius) continue;
+        if (!SegmentIsClear(start.x, start.y, x, y, 0.5 * radius)) continue;
+        best = d;
+        out = motion::Pose2D{x, y, std::atan2(y - start.y, x - start.x)};
+      }
+    }
+  }
+  if (!out) return Plan(start, goal);  // reports kStartInCollision
+  PlanResult r = Plan(*out, goal);
+  if (r.status == PlanStatus::kFound) r.path.insert(r.path.begin(), start);
+  return r;
 }
 
 double AStarPlanner::DistanceAt(double x, double y) const {

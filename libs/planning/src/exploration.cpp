@@ -14,6 +14,9 @@ std::string Format(const char* fmt, double a, double b, double c = 0.0) {
   return buf;
 }
 
+// A frontier whose centroid moved this far since it was chosen has changed [m].
+constexpr double kFrontierMovedM = 0.15;
+
 }  // namespace
 
 const char* ToString(ExplorationState s) {
@@ -58,32 +61,6 @@ bool Explorer::PathIsSafe(const motion::Pose2D& pose) const {
   return true;
 }
 
-// Plans from the robot's pose. A robot that ended up inside the robot radius of a wall (wheel slip,
-// a wall seen late) first steps to the nearest cell outside it, so it is never stranded there.
-static PlanResult PlanFrom(AStarPlanner& planner, const mapping::OccupancyGrid& map, const motion::Pose2D& pose,
-                           const motion::Pose2D& goal, double radius) {
-  if (planner.DistanceAt(pose.x, pose.y) > radius) return planner.Plan(pose, goal);
-  int cx, cy;
-  map.WorldToCell(pose.x, pose.y, &cx, &cy);
-  const int reach = static_cast<int>(std::ceil(0.3 / map.resolution()));
-  double best = std::numeric_limits<double>::infinity();
-  motion::Pose2D escape = pose;
-  for (int dy = -reach; dy <= reach; ++dy) {
-    for (int dx = -reach; dx <= reach; ++dx) {
-      double x, y;
-      map.CellToWorld(cx + dx, cy + dy, &x, &y);
-      const double d = std::hypot(x - pose.x, y - pose.y);
-      if (d < best && planner.DistanceAt(x, y) > radius) {
-        best = d;
-        escape = motion::Pose2D{x, y, pose.theta};
-      }
-    }
-  }
-  PlanResult r = planner.Plan(escape, goal);
-  if (r.status == PlanStatus::kFound) r.path.insert(r.path.begin(), pose);
-  return r;
-}
-
 void Explorer::Fail(const std::string& reason, ExplorationUpdate* u) {
   state_ = ExplorationState::kFailed;
   failure_reason_ = reason;
@@ -104,19 +81,20 @@ bool Explorer::SelectFrontier(const mapping::OccupancyGrid& map, const motion::P
   }
   for (const FrontierGoal& g : goals) {
     const Frontier& f = frontiers_[g.frontier];
-    const PlanResult plan = PlanFrom(planner_, map, pose, g.target, r);
+    const PlanResult plan = planner_.PlanSteppingOut(pose, g.target);
     if (plan.status != PlanStatus::kFound) {
       blacklist_.push_back({f.centroid_x, f.centroid_y, t_s + options_.blacklist_s});
       continue;
     }
     path_ = plan.path;
     target_frontier_ = motion::Pose2D{f.centroid_x, f.centroid_y, 0.0};
+    target_size_ = f.size();
     ++replans_;
     u->new_path = true;
     u->path = path_;
     u->reason += (u->reason.empty() ? "" : "; ") +
                  Format("exploring a frontier of %.0f cells at (%.2f, %.2f)", f.size(), f.centroid_x, f.centroid_y) +
-                 Format(" with clearance %.2f m", plan.clearance_m, 0.0);
+                 Format(" from (%.2f, %.2f)", g.target.x, g.target.y) + Format(" with clearance %.2f m", plan.clearance_m, 0.0);
     return true;
   }
   return false;
@@ -144,7 +122,7 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
   }
   const double radius = options_.astar.robot_radius_m;
   auto plan_home = [&](const std::string& why) {
-    const PlanResult plan = PlanFrom(planner_, map, pose, home_, radius);
+    const PlanResult plan = planner_.PlanSteppingOut(pose, home_);
     if (plan.status == PlanStatus::kStartInCollision) {
       // The robot's own surroundings are not clear on this map (an early map, a wall seen late):
       // wait for the next map rather than give up.
@@ -175,19 +153,28 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
     bool need = path_.empty();
     std::string why;
     if (!need && target_frontier_) {
-      bool exists = false;
+      const Frontier* match = nullptr;
+      double match_d = options_.frontier_match_m;
       for (const Frontier& f : frontiers_) {
-        exists = exists || std::hypot(f.centroid_x - target_frontier_->x, f.centroid_y - target_frontier_->y) <=
-                               options_.frontier_match_m;
+        const double d = std::hypot(f.centroid_x - target_frontier_->x, f.centroid_y - target_frontier_->y);
+        if (d <= match_d) match_d = d, match = &f;
       }
       const bool reached = std::hypot(pose.x - path_.back().x, pose.y - path_.back().y) <= options_.target_reached_m;
-      if (!exists) {
+      // What the robot saw on the way changed the frontier (part of it was resolved, its centroid
+      // moved): the target chosen for the old one may not show the rest, so choose again.
+      const bool changed = match && (match_d > kFrontierMovedM || std::abs(match->size() - target_size_) > 0.25 * target_size_);
+      if (!match) {
         need = true;
         why = "target frontier explored";
-      } else if (reached) {
+      } else if (reached && changed) {
+        need = true;
+        why = "target frontier changed, choosing again";
+      } else if (reached && reached_at_s_ < 0) {
+        reached_at_s_ = t_s;  // give the map time to show what the robot sees from here
+      } else if (reached && t_s - reached_at_s_ >= options_.resolve_wait_s) {
         // Standing at the target and the frontier is still there: nothing more can be seen from
-        // here (unknown space the sensor cannot resolve, a gap too narrow to pass). Waiting will
-        // not change that, so it is ignored for good, unlike a frontier that was only unreachable.
+        // here (unknown space the sensor cannot resolve, a gap too narrow to pass). Waiting longer
+        // will not change that, so it is ignored for good, unlike a frontier that was only unreachable.
         blacklist_.push_back({target_frontier_->x, target_frontier_->y, std::numeric_limits<double>::infinity()});
         need = true;
         why = "frontier unresolved at its target, blacklisted";
@@ -201,6 +188,7 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
       if (!why.empty()) u.reason += (u.reason.empty() ? "" : "; ") + why;
       drop_blacklisted();  // the frontier blacklisted just now drops out of the candidates
       target_frontier_.reset();
+      reached_at_s_ = -1;
       path_.clear();
       if (!SelectFrontier(map, pose, t_s, &u)) {
         if (!(planner_.DistanceAt(pose.x, pose.y) > radius) && !frontiers_.empty()) {

@@ -61,6 +61,23 @@ std::vector<Frontier> FindFrontiers(const mapping::OccupancyGrid& map, const Fro
   return out;
 }
 
+namespace {
+
+// True when the straight line between the centres of cells a and b crosses no occupied cell
+// (unknown cells do not block: the frontier's centroid usually lies in unknown space). Sampled at a
+// quarter cell, so a one-cell wall is never stepped over.
+bool SeesThrough(const mapping::OccupancyGrid& map, int ax, int ay, int bx, int by) {
+  const int steps = 4 * std::max(std::abs(bx - ax), std::abs(by - ay));
+  for (int k = 1; k < steps; ++k) {
+    const double t = double(k) / steps;
+    const int x = static_cast<int>(std::lround(ax + t * (bx - ax))), y = static_cast<int>(std::lround(ay + t * (by - ay)));
+    if (map.at(x, y) > 0) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 std::vector<FrontierGoal> RankFrontierGoals(const std::vector<Frontier>& frontiers, const motion::Pose2D& robot,
                                             const mapping::OccupancyGrid& map, AStarPlanner& planner,
                                             double clearance_m, const FrontierOptions& options,
@@ -75,11 +92,13 @@ std::vector<FrontierGoal> RankFrontierGoals(const std::vector<Frontier>& frontie
     const Frontier& f = frontiers[i];
     int cx, cy;
     map.WorldToCell(f.centroid_x, f.centroid_y, &cx, &cy);
-    int best = -1;
-    double best_d2 = std::numeric_limits<double>::infinity();
-    // Rings of growing radius around the centroid; the first ring holding reachable cells wins,
-    // the cell nearest the centroid within it (and the next ring, which can hold nearer cells
-    // by Euclidean distance) is taken.
+    int best = -1, best_blind = -1;
+    double best_d2 = std::numeric_limits<double>::infinity(), best_blind_d2 = best_d2;
+    // Rings of growing radius around the centroid; the first ring holding reachable cells that
+    // see the centroid (no wall between) wins, the cell nearest the centroid within it (and the
+    // next ring, which can hold nearer cells by Euclidean distance) is taken. A cell on the other
+    // side of a wall is nearer by distance but shows nothing of the frontier: it is used only when
+    // no reachable cell within the search radius sees the centroid.
     for (int r = 0; r <= radius_cells && double(r) * r < best_d2; ++r) {
       for (int dy = -r; dy <= r; ++dy) {
         for (int dx = -r; dx <= r; ++dx) {
@@ -89,13 +108,13 @@ std::vector<FrontierGoal> RankFrontierGoals(const std::vector<Frontier>& frontie
           const double d2 = double(dx) * dx + double(dy) * dy;
           if (d2 > double(radius_cells) * radius_cells) continue;
           const int n = y * w + x;
-          if (std::isfinite(cost[n]) && d2 < best_d2) {
-            best_d2 = d2;
-            best = n;
-          }
+          if (!std::isfinite(cost[n]) || d2 >= best_d2) continue;
+          if (d2 < best_blind_d2) best_blind_d2 = d2, best_blind = n;
+          if (SeesThrough(map, x, y, cx, cy)) best_d2 = d2, best = n;
         }
       }
     }
+    if (best < 0) best = best_blind;
     if (best < 0) {
       if (unreachable) unreachable->push_back(i);
       continue;

@@ -17,13 +17,20 @@ ObstacleDistanceGrid::ObstacleDistanceGrid(const mapping::OccupancyGrid& map, co
       origin_y_(map.origin_y()) {
   std::vector<uint8_t> obstacle(map.cells().size());
   const int threshold = options.occupied_threshold;
+  const bool separate_unknown = options.unknown_is_obstacle && options.unknown_margin_m > 0;
   for (size_t i = 0; i < obstacle.size(); ++i) {
     const int c = map.cells()[i];
-    obstacle[i] = c > threshold || (options.unknown_is_obstacle && c == 0);
+    obstacle[i] = c > threshold || (options.unknown_is_obstacle && !separate_unknown && c == 0);
   }
   dist_ = SquaredDistanceTransform(obstacle, width_, height_);
   const float res = static_cast<float>(resolution_);
   for (float& v : dist_) v = std::sqrt(v) * res;  // sqrt(inf) = inf
+  if (!separate_unknown) return;
+  // Unknown space counts as an obstacle unknown_margin_m nearer than it is.
+  for (size_t i = 0; i < obstacle.size(); ++i) obstacle[i] = map.cells()[i] == 0;
+  const std::vector<float> unknown = SquaredDistanceTransform(obstacle, width_, height_);
+  const float margin = static_cast<float>(options.unknown_margin_m);
+  for (size_t i = 0; i < dist_.size(); ++i) dist_[i] = std::min(dist_[i], std::sqrt(unknown[i]) * res + margin);
 }
 
 void ObstacleDistanceGrid::WorldToCell(double x, double y, int* cx, int* cy) const {

@@ -33,6 +33,8 @@ ObstacleDistanceOptions ParseObstacleDistanceOptions(config::Section& s, const O
   ObstacleDistanceOptions o = d;
   o.unknown_is_obstacle = s.GetBool("unknown_is_obstacle", d.unknown_is_obstacle,
                                     "unknown cells (log-odds 0) count as obstacles for distances and paths");
+  o.unknown_margin_m = s.GetDouble("unknown_margin_m", d.unknown_margin_m,
+                                   "with unknown_is_obstacle: unknown cells count as this much farther than they are [m]", 0.0, 10.0);
   o.occupied_threshold = static_cast<int>(s.GetInt("occupied_threshold", d.occupied_threshold,
                                                    "cells with log-odds above this are obstacles", -127, 126));
   return o;
@@ -56,6 +58,8 @@ ExplorationOptions ParseExplorationOptions(config::Section& s, const Exploration
                                    "exploration is completed when the robot is this close to home [m]", 0.0, 10.0);
   o.target_reached_m = s.GetDouble("target_reached_m", d.target_reached_m,
                                    "a frontier target counts as reached this close [m]", 0.0, 10.0);
+  o.resolve_wait_s = s.GetDouble("resolve_wait_s", d.resolve_wait_s,
+                                 "a frontier still there this long after its target was reached is ignored for good [s]", 0.0, 600.0);
   o.blacklist_s = s.GetDouble("blacklist_s", d.blacklist_s,
                               "how long an unreachable or unresolvable frontier is ignored [s]", 0.0, 1e6);
   o.blacklist_radius_m = s.GetDouble("blacklist_radius_m", d.blacklist_radius_m,

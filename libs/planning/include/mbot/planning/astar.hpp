@@ -82,6 +82,12 @@ class AStarPlanner {
   // Plans from `start` to `goal` (world frame, metres). Throws std::logic_error without a map.
   PlanResult Plan(const motion::Pose2D& start, const motion::Pose2D& goal);
 
+  // Plan, for a robot that may stand inside the robot radius of an obstacle (pushed there, a wall
+  // seen late, a pose corrected by localization): it first steps straight out to the nearest cell
+  // outside the radius within max_step_m that a segment keeping half the radius reaches; the path
+  // then starts at `start`. Plans as Plan does when the start is clear or no such cell exists.
+  PlanResult PlanSteppingOut(const motion::Pose2D& start, const motion::Pose2D& goal, double max_step_m = 0.3);
+
   // Single search at a fixed clearance, no easing (Moving AI benchmarks, tests).
   PlanResult PlanAtClearance(const motion::Pose2D& start, const motion::Pose2D& goal, double clearance_m);
 

@@ -33,7 +33,8 @@ struct FrontierGoal {
 };
 
 // For each frontier, the cell the robot can reach: its centroid when that cell is reachable,
-// otherwise the reachable cell nearest the centroid within options.search_radius_m. Costs come
+// otherwise the reachable cell nearest the centroid within options.search_radius_m that sees it
+// (no occupied cell on the line between; the nearest reachable cell when none does). Costs come
 // from one Dijkstra search from `robot` at `clearance_m`. Returns the goals sorted by cost, and in
 // `unreachable` the indices of frontiers with no reachable cell.
 std::vector<FrontierGoal> RankFrontierGoals(const std::vector<Frontier>& frontiers, const motion::Pose2D& robot,

@@ -17,6 +17,11 @@ struct ObstacleDistanceOptions {
   bool unknown_is_obstacle = false;
   // Cells with log-odds above this are obstacles (the botlab rule is > 0).
   int occupied_threshold = 0;
+  // With unknown_is_obstacle: an unknown cell counts as an obstacle this much farther away than it
+  // is, so a robot may come this much closer to unseen space than to a wall (0: the same). The
+  // clearance a planner needs from walls covers the grid's error (a thin wall anywhere in its cell,
+  // the robot anywhere in its own); unseen space only has to stay out of the footprint.
+  double unknown_margin_m = 0.0;
 };
 
 class ObstacleDistanceGrid {
