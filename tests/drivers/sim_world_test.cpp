@@ -452,5 +452,67 @@ TEST(SimArenas, WarehouseHasTargetsAndDropoffs) {
   EXPECT_GE(w.PosesLabelled("dropoff").size(), 2u);
 }
 
+// Global localization needs a floor that does not look the same turned by half a circle: from
+// every free pose, the scan differs from the one at the pose turned 180° about the floor's centre.
+TEST(SimArenas, WarehouseLooksDifferentTurnedAround) {
+  const World w = World::Load(std::string(MBOT_SOURCE_DIR) + "/datasets/arenas/warehouse.arena");
+  const double cx = (-0.35 + 3.92) / 2, cy = (-0.35 + 2.7) / 2;
+  int poses = 0, distinct = 0;
+  for (double x = -0.2; x < 3.8; x += 0.1) {
+    for (double y = -0.2; y < 2.6; y += 0.1) {
+      const double mx = 2 * cx - x, my = 2 * cy - y;
+      if (w.ClearanceAt(x, y) < 0.2 || w.ClearanceAt(mx, my) < 0.2) continue;
+      ++poses;
+      int differ = 0;  // beams whose ranges disagree by more than 0.1 m
+      for (int k = 0; k < 360; ++k) {
+        const double a = k * kPi / 180;
+        differ += std::abs(w.Raycast(x, y, a, 12.0) - w.Raycast(mx, my, a + kPi, 12.0)) > 0.1;
+      }
+      distinct += differ >= 20;
+    }
+  }
+  ASSERT_GT(poses, 100);
+  EXPECT_EQ(distinct, poses);
+}
+
+TEST(SimWorld, RenderKnownMapDrawsTheWallsAndTheReachableFloor) {
+  const World w = World::Load(std::string(MBOT_SOURCE_DIR) + "/datasets/arenas/warehouse.arena");
+  const mapping::OccupancyGrid m = RenderKnownMap(w, 0.05);
+  EXPECT_DOUBLE_EQ(m.resolution(), 0.05);
+  int cx, cy;
+  m.WorldToCell(0.0, 0.0, &cx, &cy);  // the start
+  EXPECT_EQ(m.at(cx, cy), -127);
+  m.WorldToCell(-0.35, 1.0, &cx, &cy);  // on the left wall
+  EXPECT_EQ(m.at(cx, cy), 127);
+  m.WorldToCell(0.9, 0.55, &cx, &cy);  // inside a shelf block: not reachable, not a wall
+  EXPECT_EQ(m.at(cx, cy), 0);
+  // Every occupied cell is within a cell of a wall, every free one clear of the walls.
+  for (int y = 0; y < m.height(); ++y) {
+    for (int x = 0; x < m.width(); ++x) {
+      double wx, wy;
+      m.CellToWorld(x, y, &wx, &wy);
+      if (m.at(x, y) > 0) EXPECT_LE(w.ClearanceAt(wx, wy), 0.025 + 1e-9);
+      if (m.at(x, y) < 0) EXPECT_GT(w.ClearanceAt(wx, wy), 0.025);
+    }
+  }
+}
+
+TEST(SimWorld, RandomFreePoseIsSeededAndKeepsItsClearance) {
+  const World w = World::Load(std::string(MBOT_SOURCE_DIR) + "/datasets/arenas/warehouse.arena");
+  const auto a = RandomFreePose(w, 0.25, 7), b = RandomFreePose(w, 0.25, 7), c = RandomFreePose(w, 0.25, 8);
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.theta, b.theta);
+  EXPECT_NE(a.x, c.x);
+  const auto mask = ReachableFreeMask(w, w.PosesLabelled("start").at(0));
+  for (uint64_t seed = 0; seed < 50; ++seed) {
+    const auto p = RandomFreePose(w, 0.25, seed);
+    EXPECT_GE(w.ClearanceAt(p.x, p.y), 0.25);
+    int cx, cy;
+    w.truth().WorldToCell(p.x, p.y, &cx, &cy);
+    EXPECT_TRUE(mask[static_cast<size_t>(cy) * w.truth().width() + cx]) << p.x << ", " << p.y;  // not inside a shelf
+  }
+  EXPECT_THROW(RandomFreePose(w, 5.0, 1), std::runtime_error);
+}
+
 }  // namespace
 }  // namespace mbot::drivers

@@ -263,5 +263,21 @@ TEST(MotionControllerTest, ArrivalLatchesZeroUntilSetPath) {
   }
 }
 
+TEST(MotionControllerTest, CorrectionToAPoseJustBehindBacksUp) {
+  MotionController c(MotionControllerOptions{});
+  c.SetPath({{0.0, 0.0, 0.0}});
+  Pose2D p{0.05, 0.002, 0.0};  // 5 cm past the goal, facing away from it
+  VelocityCommand v;
+  for (int i = 0; i < 10; ++i) v = c.Update(p, 0.02);
+  EXPECT_LT(v.v_m_s, 0.0);
+  EXPECT_LT(std::abs(v.w_rad_s), 0.5);
+  // Farther than reverse_within_m: it turns round as before.
+  MotionController far(MotionControllerOptions{});
+  far.SetPath({{0.0, 0.0, 0.0}});
+  for (int i = 0; i < 10; ++i) v = far.Update({0.5, 0.002, 0.0}, 0.02);
+  EXPECT_EQ(v.v_m_s, 0.0);
+  EXPECT_GT(std::abs(v.w_rad_s), 0.0);
+}
+
 }  // namespace
 }  // namespace mbot::motion

@@ -233,5 +233,27 @@ TEST(AStarTest, OptionsParsedStrictly) {
   EXPECT_THROW(ParseAStarOptions(b), config::ConfigError);
 }
 
+TEST(AStarPlannerTest, PlanSteppingOutLeavesTheRadiusFirst) {
+  // An open room; the robot stands 0.07 m from the left wall, inside the 0.12 m planning radius.
+  mapping::OccupancyGrid g(60, 40, 0.05, 0, 0, -100);
+  for (int y = 0; y < 40; ++y) g.at(0, y) = g.at(59, y) = 100;
+  for (int x = 0; x < 60; ++x) g.at(x, 0) = g.at(x, 39) = 100;
+  AStarOptions o;
+  o.robot_radius_m = 0.12;
+  AStarPlanner planner(o);
+  planner.SetMap(ObstacleDistanceGrid(g, {}));
+  const motion::Pose2D start{0.12, 1.0, 0}, goal{2.0, 1.0, 0};
+  EXPECT_EQ(planner.Plan(start, goal).status, PlanStatus::kStartInCollision);
+  const PlanResult r = planner.PlanSteppingOut(start, goal);
+  ASSERT_EQ(r.status, PlanStatus::kFound);
+  ASSERT_GE(r.path.size(), 3u);
+  EXPECT_DOUBLE_EQ(r.path.front().x, start.x);
+  EXPECT_GT(planner.DistanceAt(r.path[1].x, r.path[1].y), 0.12);        // out of the radius
+  EXPECT_LT(std::hypot(r.path[1].x - start.x, r.path[1].y - start.y), 0.1);  // by a short step
+  EXPECT_NEAR(r.path.back().x, goal.x, 1e-9);
+  // A clear start plans as Plan does.
+  EXPECT_EQ(planner.PlanSteppingOut({1.0, 1.0, 0}, goal).path.size(), planner.Plan({1.0, 1.0, 0}, goal).path.size());
+}
+
 }  // namespace
 }  // namespace mbot::planning

@@ -57,5 +57,34 @@ TEST(FrontiersTest, GoalIsCentroidOrNearestReachableCell) {
   EXPECT_EQ(unreachable, std::vector<int>{0});
 }
 
+TEST(FrontiersTest, GoalSeesTheFrontierRatherThanStandingBehindAWall) {
+  // A corridor 0.55 m wide narrows to 0.25 m (too narrow for 0.15 m clearance) at y = 0.9 m, and its
+  // narrow part opens to unknown space at y = 1.5 m. A thick wall (x 0.3-0.65 m) separates it from a
+  // second corridor known up to y = 1.6 m. The reachable cell nearest the frontier's centroid is in
+  // the second corridor, behind the wall (0.65 m away); the goal must be the one below the narrow
+  // part (0.70 m away), which looks up it.
+  OccupancyGrid g(40, 40, 0.05, 0, 0, 0);
+  for (int y = 1; y < 30; ++y) {
+    for (int x = 1; x < 39; ++x) g.at(x, y) = -100;
+  }
+  for (int y = 0; y < 40; ++y) g.at(0, y) = g.at(39, y) = 100;
+  for (int x = 0; x < 40; ++x) g.at(x, 0) = 100;
+  for (int y = 18; y < 40; ++y) {
+    for (int x = 6; x <= 12; ++x) g.at(x, y) = 100;  // the thick wall above y = 0.9 m
+  }
+  for (int y = 10; y < 18; ++y) g.at(12, y) = 100;  // the two corridors are apart from y = 0.5 m
+  for (int x = 13; x < 39; ++x) g.at(x, 30) = g.at(x, 31) = -100;  // the second corridor is known higher up
+  for (int x = 13; x < 39; ++x) g.at(x, 32) = 100;
+  const std::vector<Frontier> f = FindFrontiers(g, {5, 1.0});
+  ASSERT_EQ(f.size(), 1u);
+  ASSERT_LT(f[0].centroid_x, 0.3);
+  AStarPlanner planner;
+  planner.SetMap(ObstacleDistanceGrid(g, {true, 0}));
+  const std::vector<FrontierGoal> goals = RankFrontierGoals(f, {1.5, 0.3, 0}, g, planner, 0.15, {5, 1.0});
+  ASSERT_EQ(goals.size(), 1u);
+  EXPECT_LT(goals[0].target.x, 0.3) << "goal at " << goals[0].target.x << ", " << goals[0].target.y;
+  EXPECT_LT(goals[0].target.y, 0.9);
+}
+
 }  // namespace
 }  // namespace mbot::planning

@@ -90,5 +90,20 @@ TEST(ObstacleDistanceGridTest, OccupiedThresholdIsStrict) {
   EXPECT_TRUE(std::isinf(ObstacleDistanceGrid(g, {false, 10}).at(2, 0)));
 }
 
+TEST(ObstacleDistanceGridTest, UnknownMarginCountsUnseenSpaceFarther) {
+  // One row: a wall at x = 0, free cells, unknown from x = 8 on.
+  OccupancyGrid g(12, 1, 1.0, 0, 0, -127);
+  g.at(0, 0) = 100;
+  for (int x = 8; x < 12; ++x) g.at(x, 0) = 0;
+  const ObstacleDistanceGrid same(g, {true, 0, 0.0});
+  EXPECT_EQ(same.at(6, 0), 2.0f);  // the unknown cell at x = 8
+  const ObstacleDistanceGrid margin(g, {true, 0, 1.5});
+  EXPECT_EQ(margin.at(6, 0), 3.5f);  // 2 + 1.5, still nearer than the wall (6)
+  EXPECT_EQ(margin.at(2, 0), 2.0f);  // walls keep their distance
+  EXPECT_EQ(margin.at(8, 0), 1.5f);  // an unknown cell is the margin away from itself
+  const ObstacleDistanceGrid unknown_free(g, {false, 0, 1.5});
+  EXPECT_EQ(unknown_free.at(6, 0), 6.0f);  // the margin only matters when unknown is an obstacle
+}
+
 }  // namespace
 }  // namespace mbot::planning

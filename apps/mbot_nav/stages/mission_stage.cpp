@@ -417,6 +417,8 @@ StageType MissionStageType() {
             c.final_heading_tolerance_rad = s.GetDouble("final_heading_tolerance_rad", c.final_heading_tolerance_rad,
                                                         "heading tolerance at the last waypoint [rad]", 0.001, 3.2);
             c.lookahead_m = s.GetDouble("lookahead_m", c.lookahead_m, "pure pursuit look-ahead [m]", 0.01, 5.0);
+            c.reverse_within_m = s.GetDouble("reverse_within_m", c.reverse_within_m,
+                                             "a correction to a final pose this near and behind backs up instead of turning round [m]", 0.0, 1.0);
             o.exploration = planning::ParseExplorationOptions(s);
             o.explore_period_s = s.GetDouble("explore_period_s", o.explore_period_s, "explorer updates at most this often [s]", 0.0, 60.0);
             o.start_delay_s = s.GetDouble("start_delay_s", o.start_delay_s, "stand still this long after the first SLAM pose [s]", 0.0, 60.0);

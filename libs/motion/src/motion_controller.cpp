@@ -69,10 +69,19 @@ VelocityCommand MotionController::Update(const Pose2D& pose, double dt_s) {
 VelocityCommand MotionController::Target(const Pose2D& pose) {
   if (phase_ == Phase::kFollow) {
     VelocityCommand cmd;
+    const size_t last = waypoints_.size() - 1;
+    const double d_last = Dist(pose, waypoints_[last]);
+    // A final pose a few centimetres behind the robot (it overshot, or stopped short of a correction):
+    // back up to it rather than turn round, drive two centimetres and turn back.
+    if (last == 0 && d_last < options_.reverse_within_m && d_last >= options_.final_tolerance_m &&
+        std::abs(Bearing(pose, waypoints_[last].x, waypoints_[last].y)) > M_PI / 2) {
+      const double e = WrapAngle(Bearing(pose, waypoints_[last].x, waypoints_[last].y) - M_PI);
+      if (std::abs(e) > options_.turn_in_place_rad) return {0.0, TurnRate(e)};
+      return {-Speed(d_last) * std::cos(e), TurnRate(e)};
+    }
     if (options_.kind == ControllerKind::kPurePursuit) {
       if (PurePursuit(pose, &cmd)) return cmd;
     } else {
-      const size_t last = waypoints_.size() - 1;
       while (target_ < last && Dist(pose, waypoints_[target_]) < options_.intermediate_tolerance_m) ++target_;
       if (target_ < last || Dist(pose, waypoints_[last]) >= options_.final_tolerance_m) {
         return DriveTowards(pose, waypoints_[target_].x, waypoints_[target_].y, RtrStopDistance(pose));

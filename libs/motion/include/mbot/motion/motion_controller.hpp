@@ -46,6 +46,9 @@ struct MotionControllerOptions {
   // approached grows as the distance shrinks, and a weaker turn gain would orbit the point.
   double k_bearing = 4.0;
   double lookahead_m = 0.25;  // pure pursuit: arc length from the projection to the look-ahead point
+  // A path of one pose (a correction at the goal) nearer than this and behind the robot is reached
+  // by backing up, not by turning round (0: never reverse).
+  double reverse_within_m = 0.10;
 };
 
 struct ControllerProgress {
