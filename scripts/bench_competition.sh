@@ -21,9 +21,11 @@ rows = [json.load(open(os.path.join(d, str(s), 'score.json'))) for s in range(1,
         if os.path.exists(os.path.join(d, str(s), 'score.json'))]
 med = lambda xs: statistics.median(xs) if xs else float('nan')
 done = [r for r in rows if r['completed']]
-line = '| %s | %d/%d | %s / %s | %.1f s | %d | ' % (
-    name, len(done), n, med([r['points']['total'] for r in rows]), rows[0]['points']['max'] if rows else '-',
-    med([r['time_s'] for r in done]), sum(1 for r in rows if r['collisions'] > 0))
+pts = [r['points']['total'] for r in rows]
+times = [r['time_s'] for r in done]
+line = '| %s | %d/%d | %g (min %g) of %s | %.1f s [%.1f-%.1f] | %d | ' % (
+    name, len(done), n, med(pts), min(pts), rows[0]['points']['max'],
+    med(times), min(times), max(times), sum(1 for r in rows if r['collisions'] > 0))
 if 'map' in rows[0]:
     line += '%.3f / %.3f m, %.1f deg | %.1f %% (min %.1f %%) | ' % (
         med([r['final_error']['x_m'] for r in done]), med([r['final_error']['y_m'] for r in done]),
@@ -37,8 +39,10 @@ line += '%.0fx |' % med([r['real_time_factor'] for r in rows])
 print(line, flush=True)
 PY
 }
-echo "| event / arena | completed | points (median) | time (median) | runs with a collision | final pose error (median) / warehouse | map coverage (median) / warehouse | RTF (median) |"
+echo "| event / arena | completed | points, median (min) | time, median [range] | runs with a collision | final pose error (median) / warehouse | map coverage (median) / warehouse | RTF (median) |"
 echo "|---|---|---|---|---|---|---|---|"
 run speed_run speed_run.ini
 for m in maze_1 maze_2 maze_3; do run "maze_explorer/$m" maze_explorer.ini --set "source.path=datasets/arenas/$m.arena"; done
+run maze_explorer/center_maze maze_explorer.ini --set 'source.path=${datasets}/botlab/mbot_example_logs_maps/center_maze.map' \
+  --set 'source.start=-0.9, -0.6, 45'
 run warehouse warehouse.ini

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 
 #include "../regression/run_config.hpp"
 #include "competition.hpp"
@@ -27,12 +28,14 @@ TEST_P(SpeedRun, DrivesTheCircuitAndStopsWithin3cm3cm15DegWithoutCollision) {
 }
 INSTANTIATE_TEST_SUITE_P(Seeds, SpeedRun, ::testing::Values(1, 2));
 
-class MazeExplorer : public ::testing::TestWithParam<int> {};
+class MazeExplorer : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
 
 TEST_P(MazeExplorer, MapsTheReachableSpaceAndReturnsHomeWithoutCollision) {
-  const int seed = GetParam();
-  const std::string j = RunConfig("maze_explorer.ini", "maze_explorer_" + std::to_string(seed),
-                                  {"pipeline.seed=" + std::to_string(seed)}, "score.json");
+  const auto& [arena, seed] = GetParam();
+  const std::string j = RunConfig("maze_explorer.ini", "maze_explorer_" + arena + "_" + std::to_string(seed),
+                                  {"pipeline.seed=" + std::to_string(seed),
+                                   "source.path=" + std::string(MBOT_SOURCE_DIR) + "/datasets/arenas/" + arena + ".arena"},
+                                  "score.json");
   ASSERT_FALSE(j.empty());
   EXPECT_NE(j.find("\"completed\": true"), std::string::npos) << j;
   EXPECT_EQ(Get(j, {"collisions"}), 0);
@@ -41,7 +44,9 @@ TEST_P(MazeExplorer, MapsTheReachableSpaceAndReturnsHomeWithoutCollision) {
   EXPECT_LE(std::hypot(Get(j, {"final_error", "x_m"}), Get(j, {"final_error", "y_m"})), 0.05);
   for (const char* k : {"time_s", "real_time_factor"}) RecordProperty(k, std::to_string(Get(j, {k})));
 }
-INSTANTIATE_TEST_SUITE_P(Seeds, MazeExplorer, ::testing::Values(1, 2));
+INSTANTIATE_TEST_SUITE_P(ArenasAndSeeds, MazeExplorer,
+                         ::testing::Combine(::testing::Values("maze_1", "maze_2", "maze_3"), ::testing::Values(1, 2)),
+                         [](const auto& info) { return std::get<0>(info.param) + "_seed" + std::to_string(std::get<1>(info.param)); });
 
 class Warehouse : public ::testing::TestWithParam<int> {};
 
@@ -96,6 +101,36 @@ TEST(MazeExplorer, InterruptedRunStillWritesMapTrajectoriesAndScore) {
   for (const char* f : {"final_map.png", "final_map.map", "true_path.tum", "slam_path.tum", "mission.json"}) {
     EXPECT_GT(std::filesystem::file_size(out + "/" + f), 0u) << f;
   }
+}
+
+// A simulated run recorded by the `recorder` stage replays through the LCM log source like a robot's
+// log: the same scans, and SLAM on the replay as accurate as it was live (a replay is its own SLAM
+// run with the same seed, so the figures agree within noise, not to the bit).
+TEST(Recording, ASimulatedRunReplaysThroughTheLogSource) {
+  const std::string live = RunConfig("speed_run.ini", "recorded_speed_run",
+                                     {"pipeline.stages=slam, mission, referee, recorder", "recorder.type=recorder"},
+                                     "metrics.json");
+  ASSERT_FALSE(live.empty());
+  const std::string log = ::testing::TempDir() + "/recorded_speed_run/recording.log";
+  ASSERT_TRUE(std::filesystem::exists(log));
+  const std::string out = ::testing::TempDir() + "/recorded_speed_run_replay";
+  std::filesystem::remove_all(out);
+  auto c = config::Config::FromString("include = defaults.ini\n[pipeline]\nstages = slam\nprogress = off\n[source]\npath = " + log +
+                                          "\n[output]\ndir = " + out +
+                                          "\n[slam]\ntype = slam\nmode = full_slam\nparticles = 300\ninitial_pose = origin\n",
+                                      "replay.ini", std::string(MBOT_SOURCE_DIR) + "/config");
+  auto plan = BuildPlan(c);
+  std::atomic<bool> stop{false};
+  RunPlan(plan, stop);
+  std::ifstream in(out + "/metrics.json");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string replay = ss.str();
+  ASSERT_FALSE(replay.empty());
+  EXPECT_EQ(Get(replay, {"scans"}), Get(live, {"scans"}));
+  EXPECT_EQ(Get(replay, {"scans_skipped"}), 0);
+  EXPECT_LT(Get(replay, {"slam_ate", "aligned", "xy_m", "rmse"}), 0.02);
+  EXPECT_NEAR(Get(replay, {"slam_ate", "aligned", "xy_m", "rmse"}), Get(live, {"slam_ate", "aligned", "xy_m", "rmse"}), 0.01);
 }
 
 // The README's first command: config/competition.ini runs every simulated event with one seed and

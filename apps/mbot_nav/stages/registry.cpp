@@ -9,7 +9,8 @@ const std::vector<StageType>& StageTypes() {
     std::vector<StageType> t = {InspectStageType(), TrajectoryWriterStageType(), MapWriterStageType(),
                                    AStarTestStageType(), MovingAiBenchmarkStageType(), ExplorationStageType(),
                                    SlamStageType(), OdometryStageType(), MotorCalibrationStageType(),
-                                   ActionModelFitStageType(), MissionStageType(), RefereeStageType()};
+                                   ActionModelFitStageType(), MissionStageType(), RefereeStageType(),
+                                   RecorderStageType()};
     std::sort(t.begin(), t.end(), [](const StageType& a, const StageType& b) { return a.name < b.name; });
     return t;
   }();

@@ -17,5 +17,6 @@ StageType MotorCalibrationStageType();
 StageType ActionModelFitStageType();
 StageType MissionStageType();
 StageType RefereeStageType();
+StageType RecorderStageType();
 
 }  // namespace mbot::app

@@ -405,4 +405,93 @@ std::vector<std::pair<int64_t, TypeInfo>> KnownTypes() {
   return out;
 }
 
+namespace {
+
+template <typename T>
+void EncodeMessage(const T& m, std::vector<uint8_t>* out) {
+  out->resize(static_cast<size_t>(m.getEncodedSize()));
+  m.encode(out->data(), 0, static_cast<int>(out->size()));
+}
+
+}  // namespace
+
+bool Encode(const Event& ev, std::vector<uint8_t>* out) {
+  out->clear();
+  switch (ev.kind) {
+    case EventKind::kLidar: {
+      const auto& scan = std::get<LidarScan>(ev.payload);
+      mbot_legacy::lidar_t m{};
+      m.utime = ev.stamp_us;
+      m.num_ranges = static_cast<int32_t>(scan.ranges_m.size());
+      m.ranges = scan.ranges_m;
+      m.thetas.resize(scan.angles_rad.size());
+      for (size_t i = 0; i < scan.angles_rad.size(); ++i) m.thetas[i] = -scan.angles_rad[i];  // clockwise on the wire
+      m.times = scan.beam_times_us;
+      m.times.resize(scan.ranges_m.size(), ev.stamp_us);
+      m.intensities = scan.intensities;
+      m.intensities.resize(scan.ranges_m.size(), 0.0f);
+      if (m.thetas.size() != scan.ranges_m.size()) return false;
+      EncodeMessage(m, out);
+      return true;
+    }
+    case EventKind::kOdometry:
+    case EventKind::kGroundTruth:
+    case EventKind::kReferencePose:
+    case EventKind::kPoseEstimate:
+    case EventKind::kCollision: {
+      const auto& p = std::get<motion::Pose2D>(ev.payload);
+      mbot_lcm_msgs::pose2D_t m{};
+      m.utime = ev.stamp_us;
+      m.x = static_cast<float>(p.x), m.y = static_cast<float>(p.y), m.theta = static_cast<float>(p.theta);
+      EncodeMessage(m, out);
+      return true;
+    }
+    case EventKind::kEncoders: {
+      const auto& e = std::get<EncoderTicks>(ev.payload);
+      mbot_lcm_msgs::mbot_encoders_t m{};
+      m.utime = ev.stamp_us;
+      m.ticks[0] = e.left_ticks, m.ticks[1] = e.right_ticks;
+      m.delta_ticks[0] = e.left_delta, m.delta_ticks[1] = e.right_delta;
+      m.delta_time = static_cast<int32_t>(e.delta_time_us);
+      EncodeMessage(m, out);
+      return true;
+    }
+    case EventKind::kImu: {
+      const auto& imu = std::get<Imu>(ev.payload);
+      mbot_lcm_msgs::mbot_imu_t m{};
+      m.utime = ev.stamp_us;
+      for (int i = 0; i < 3; ++i) {
+        m.gyro[i] = static_cast<float>(imu.gyro_rad_s[i]);
+        m.accel[i] = static_cast<float>(imu.accel_m_s2[i]);
+        m.angles_rpy[i] = static_cast<float>(imu.angles_rpy_rad[i]);
+      }
+      EncodeMessage(m, out);
+      return true;
+    }
+    case EventKind::kMotorCommand:
+    case EventKind::kWheelSpeed: {
+      const auto& c = std::get<MotorCommand>(ev.payload);
+      if (c.kind == MotorCommand::Kind::kVelocity) {
+        mbot_lcm_msgs::twist2D_t m{};
+        m.utime = ev.stamp_us;
+        m.vx = static_cast<float>(c.a), m.wz = static_cast<float>(c.b);
+        EncodeMessage(m, out);
+      } else if (c.kind == MotorCommand::Kind::kPwm) {
+        mbot_lcm_msgs::mbot_motor_pwm_t m{};
+        m.utime = ev.stamp_us;
+        m.pwm[0] = static_cast<float>(c.a), m.pwm[1] = static_cast<float>(c.b);
+        EncodeMessage(m, out);
+      } else {
+        mbot_lcm_msgs::mbot_motor_vel_t m{};
+        m.utime = ev.stamp_us;
+        m.velocity[0] = static_cast<float>(c.a), m.velocity[1] = static_cast<float>(c.b);
+        EncodeMessage(m, out);
+      }
+      return true;
+    }
+    default:
+      return false;
+  }
+}
+
 }  // namespace mbot::drivers::lcm_adapter

@@ -28,6 +28,12 @@ const TypeInfo* LookUp(int64_t fingerprint);
 bool Decode(const std::string& channel, const uint8_t* data, size_t size, const ChannelRoles& roles,
             Event* event, std::string* error);
 
+// Encodes an event as the current (2023+) mbot_lcm_msgs message a robot would publish on its
+// channel: lidar_t (angles clockwise again), pose2D_t for every pose kind, mbot_encoders_t,
+// mbot_imu_t, twist2D_t (velocity commands), mbot_motor_pwm_t, mbot_motor_vel_t. Returns false,
+// leaving `out` empty, for kinds that have no such message (maps, paths, statuses, samples).
+bool Encode(const Event& event, std::vector<uint8_t>* out);
+
 // All registered fingerprints (for tests and --list-types).
 std::vector<std::pair<int64_t, TypeInfo>> KnownTypes();
 
