@@ -30,6 +30,10 @@ using motion::TimedPose;
 
 enum class Task { kWaypoints, kExplore, kWarehouse };
 
+// Within this many final tolerances of the goal, a correction only turns on the spot, and after a
+// first correction the position counts as reached.
+constexpr double kTurnOnlyWithin = 1.5;
+
 
 const char* TaskName(Task t) { return t == Task::kWaypoints ? "waypoints" : t == Task::kExplore ? "explore" : "warehouse"; }
 
@@ -172,13 +176,23 @@ class MissionStage : public Stage {
     if (std::abs(v.v_m_s) > 0.005 || std::abs(v.w_rad_s) > 0.02) return false;
     const double d = std::hypot(goal_.x - pose.x, goal_.y - pose.y);
     const double e = std::abs(motion::WrapAngle(goal_.theta - pose.theta));
-    if ((d <= o_.controller.final_tolerance_m && e <= o_.controller.final_heading_tolerance_rad) || corrections_ >= o_.max_corrections) {
+    // A diff-drive robot cannot step sideways: re-driving to a point a centimetre or two off turns
+    // towards it (up to 90 degrees), creeps, and turns back, and can end worse than it began. So
+    // the position tolerance is final_tolerance_m on arrival, and kTurnOnlyWithin times that once a
+    // correction has been made; within it a wrong heading is corrected by turning on the spot.
+    const double tolerance = o_.controller.final_tolerance_m * (corrections_ > 0 ? kTurnOnlyWithin : 1.0);
+    const bool heading_ok = e <= o_.controller.final_heading_tolerance_rad;
+    if ((d <= tolerance && heading_ok) || corrections_ >= o_.max_corrections) {
       *how = std::to_string(corrections_) + " corrections; off by " + Num(d, 3) + " m, " + Num(e * 180 / M_PI, 3) +
              " deg by its own estimate";
       return true;
     }
     ++corrections_, ++total_corrections_;
-    SetPath({goal_}, t_us);
+    if (!heading_ok && d <= kTurnOnlyWithin * o_.controller.final_tolerance_m) {
+      SetPath({Pose2D{pose.x, pose.y, goal_.theta}}, t_us);
+    } else {
+      SetPath({goal_}, t_us);
+    }
     return false;
   }
 
