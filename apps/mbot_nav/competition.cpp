@@ -3,11 +3,13 @@
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
+#include <filesystem>
 #include <set>
 #include <sstream>
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/log.hpp"
+#include "mbot/common/strings.hpp"
 #include "stages/report.hpp"
 
 namespace mbot::app {
@@ -46,10 +48,12 @@ CompetitionPlan BuildCompetition(const config::Config& config) {
     if (!used.insert(name).second) c.Fail("events", "'" + name + "' is listed twice or is a reserved section");
     if (!config.HasSection(name)) c.Fail("events", "event '" + name + "' has no [" + name + "] section");
   }
+  // Event sections not listed in `events` are allowed (competition.events=warehouse runs one of
+  // them); any other section is a mistake.
   for (const std::string& name : config.SectionNames()) {
-    if (!used.count(name)) {
+    if (!used.count(name) && !config.GetSection(name).Has("config")) {
       throw config::ConfigError(config.SectionOrigin(name).ToString() + ": [" + name +
-                                "] is not used (not an event listed in [competition] events, and not competition/output)");
+                                "] is not used (not an event section with a config key, and not competition/output)");
     }
   }
   for (const std::string& name : events) {
@@ -57,8 +61,16 @@ CompetitionPlan BuildCompetition(const config::Config& config) {
     const std::string path = e.RequirePath("config", "the event's own configuration (an INI a single run takes)");
     const std::string world = e.GetPath("world", "", "another world for the event (its [source] path: an arena or a map)");
     const long long event_seed = e.GetInt("seed", seed, "this event's seed", 0);
-    const std::vector<std::string> sets = e.GetList("set", {}, "section.key=value overrides of the event's configuration");
+    const std::string set_text = e.GetString("set", "", "section.key=value overrides of the event's configuration, separated by ';'");
     e.Finish();
+    std::vector<std::string> sets;
+    for (size_t b = 0; b <= set_text.size();) {
+      const size_t end = std::min(set_text.find(';', b), set_text.size());
+      const std::string item = Trim(set_text.substr(b, end - b));
+      if (!item.empty()) sets.push_back(item);
+      b = end + 1;
+    }
+    if (!world.empty() && !std::filesystem::exists(world)) e.Fail("world", world + ": no such file");
     config::Config event;
     try {
       event = config::Config::Load(path);
@@ -74,7 +86,12 @@ CompetitionPlan BuildCompetition(const config::Config& config) {
     } catch (const config::ConfigError& err) {
       e.Fail("set", err.what());
     }
-    plan.events.push_back({name, BuildPlan(event)});
+    try {
+      plan.events.push_back({name, BuildPlan(event)});
+    } catch (const config::ConfigError& err) {
+      throw config::ConfigError(config.SectionOrigin(name).ToString() + ": [" + name + "] (config = " + path +
+                                ", with this section's seed, world and set): " + err.what());
+    }
   }
   return plan;
 }
@@ -104,7 +121,7 @@ int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
       r.max_points = Value(s.results, "max_points");
       r.collisions = Value(s.results, "collisions");
       r.rtf = Value(s.results, "real_time_factor");
-      if (r.points.empty()) r.result = "not scored (no referee stage in " + e.name + ")";
+      if (r.points.empty()) r.result = "not scored (the referee of " + e.name + " reported no score)";
       if (s.interrupted) status = 130;
     } catch (const std::exception& ex) {
       mbot::log::Error("competition: " + e.name + ": " + ex.what());
@@ -115,12 +132,14 @@ int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
   }
 
   int total = 0, max_total = 0;
+  bool incomplete = false;  // an event that should have scored did not
   std::ostringstream t;
   t << "\nCompetition on the simulator (Winter 2024 rules)\n"
     << std::left << std::setw(15) << "event" << std::setw(22) << "arena" << std::setw(6) << "seed" << std::setw(12) << "result"
     << std::right << std::setw(8) << "time s" << std::setw(11) << "points" << std::setw(6) << "hits" << std::setw(7) << "RTF" << "\n";
   for (const Row& r : rows) {
     if (r.points.empty()) {
+      incomplete = true;
       t << std::left << std::setw(15) << (r.event.empty() ? r.name : r.event) << r.result << "\n";
       continue;
     }
@@ -135,7 +154,7 @@ int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
       << (colon == std::string::npos ? "" : ":" + n.substr(colon + 1)) << "\n";
   }
   t << std::left << std::setw(63) << "total" << std::right << std::setw(11) << (std::to_string(total) + " / " + std::to_string(max_total))
-    << "\n";
+    << (incomplete ? "  (incomplete: an event above has no score)" : "") << "\n";
   std::cout << t.str() << std::flush;
 
   std::ostringstream j;
@@ -151,7 +170,8 @@ int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
   }
   j << "\n  ],\n  \"not_run\": [";
   for (size_t i = 0; i < plan.not_run.size(); ++i) j << (i ? ", " : "") << JsonString(plan.not_run[i]);
-  j << "],\n  \"points\": " << total << ",\n  \"max_points\": " << max_total << "\n}\n";
+  j << "],\n  \"points\": " << total << ",\n  \"max_points\": " << max_total
+    << ",\n  \"complete\": " << (incomplete ? "false" : "true") << "\n}\n";
   EnsureDirectory(plan.output_dir);
   WriteFileAtomically(plan.output_dir + "/competition.json", [&](std::ostream& out) { out << j.str(); });
   return status;

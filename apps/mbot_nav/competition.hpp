@@ -3,7 +3,8 @@
 // A config with a [competition] section describes it:
 //   [competition]  events = <section names, in order>; seed; not_run = <"Event: why" lines>
 //   [<event>]      config = <the event's INI>; optional world (its source.path), seed, and
-//                  set = <section.key=value overrides of the event's config>
+//                  set = <section.key=value overrides of the event's config, separated by ';'>
+//                  (event sections not listed in `events` are allowed and not run)
 //   [output]       dir: each event writes to dir/<event>/, the table goes to dir/competition.json
 #pragma once
 

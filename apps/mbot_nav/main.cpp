@@ -115,7 +115,7 @@ int main(int argc, char** argv) {
   } catch (const mbot::config::ConfigError& e) {
     std::cerr << "mbot_nav: configuration error: " << e.what() << "\n";
     return 2;
-  } catch (const std::runtime_error& e) {  // an event's config file that does not load
+  } catch (const std::runtime_error& e) {  // a file the configuration names that cannot be read
     std::cerr << "mbot_nav: configuration error: " << e.what() << "\n";
     return 2;
   }

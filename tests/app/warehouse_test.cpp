@@ -3,7 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <set>
+#include <sstream>
+
+#include "mbot/common/config.hpp"
+#include "stage.hpp"
 
 namespace mbot::app {
 namespace {
@@ -45,6 +51,82 @@ TEST(WarehouseRules, AnArenaWithoutEnoughTargetsIsNamed) {
     ADD_FAILURE();
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("'tiny' needs 7 'pose target' lines"), std::string::npos) << e.what();
+  }
+}
+
+// The referee judges stops from the true pose: standing 2 s at a later stop marks the one before it
+// missed, so that delivery fails while the next still counts (level 1 reached, level 2 not).
+// Feeds a warehouse referee (seed 5) true poses at 100 Hz; Finish writes score.json.
+class RefereeHarness {
+ public:
+  explicit RefereeHarness(const std::string& name) : out_(::testing::TempDir() + "/" + name) {
+    auto c = config::Config::FromString("[referee]\ntype = referee\nevent = warehouse\ntime_limit_s = 720\n");
+    config::Section section = c.GetSection("referee");
+    referee_ = FindStageType("referee")->create(section);
+    std::filesystem::create_directories(out_);
+    ctx_ = RunContext{out_, 5, nullptr, std::string(MBOT_SOURCE_DIR) + "/datasets/arenas/warehouse.arena", nullptr};
+    referee_->Start(ctx_);
+  }
+  void Stand(const motion::Pose2D& p, double seconds) {
+    for (int i = 0; i < seconds * 100; ++i, t_ += 10'000) {
+      referee_->OnEvent(drivers::Event{t_, t_, "TRUE_POSE", drivers::EventKind::kGroundTruth, p});
+    }
+  }
+  // score.json, and its stop lines (line k + 1 is stop k).
+  std::string Finish(std::vector<std::string>* lines) {
+    referee_->Finish(ctx_, false);
+    std::ifstream in(out_ + "/score.json");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const std::string j = ss.str();
+    std::stringstream rows(j.substr(std::min(j.size(), j.find("\"stops\": ["))));
+    for (std::string line; std::getline(rows, line);) lines->push_back(line);
+    return j;
+  }
+
+ private:
+  std::string out_;
+  std::unique_ptr<Stage> referee_;
+  RunContext ctx_;
+  int64_t t_ = 0;
+};
+
+TEST(WarehouseReferee, AMissedStopFailsItsDeliveryAndTheNextStillCounts) {
+  const auto stops = warehouse::Stops(Warehouse(), 5);
+  RefereeHarness h("warehouse_referee_missed");
+  h.Stand(stops[0].pose, 2.2);                                  // target of delivery 1: done
+  h.Stand({stops[1].pose.x + 0.3, stops[1].pose.y, 0}, 1.0);    // near its drop-off, but not at it
+  h.Stand(stops[2].pose, 2.2);                                  // on to delivery 2: drop-off 1 missed
+  h.Stand(stops[3].pose, 1.0);                                  // too short to count...
+  h.Stand({0, 0, 0}, 0.01);
+  h.Stand(stops[3].pose, 2.2);                                  // ...the second visit does
+  std::vector<std::string> lines;
+  const std::string j = h.Finish(&lines);
+  EXPECT_NE(j.find("\"levels_reached\": 1,"), std::string::npos) << j;
+  ASSERT_GE(lines.size(), 6u);
+  EXPECT_NE(lines[1].find("\"missed\": false"), std::string::npos) << lines[1];  // target 1
+  EXPECT_EQ(lines[1].find("\"done_at_s\": null"), std::string::npos) << lines[1];
+  EXPECT_NE(lines[2].find("\"missed\": true"), std::string::npos) << lines[2];   // its drop-off
+  EXPECT_NE(lines[3].find("\"missed\": false"), std::string::npos) << lines[3];
+  EXPECT_NE(lines[4].find("\"missed\": false"), std::string::npos) << lines[4];
+  EXPECT_EQ(lines[4].find("\"done_at_s\": null"), std::string::npos) << lines[4];
+  EXPECT_NE(lines[5].find("\"done_at_s\": null, \"missed\": false"), std::string::npos) << lines[5];  // not reached
+}
+
+// The drop-offs repeat (stop 5 is drop-off 1 again): standing on at drop-off 1 after delivering to
+// it does not count as the later visit, and does not mark the stops between missed.
+TEST(WarehouseReferee, StayingAtADropOffDoesNotCountItsNextVisit) {
+  const auto stops = warehouse::Stops(Warehouse(), 5);
+  ASSERT_EQ(stops[5].pose.x, stops[1].pose.x);
+  RefereeHarness h("warehouse_referee_stay");
+  h.Stand(stops[0].pose, 2.2);
+  h.Stand(stops[1].pose, 6.0);
+  std::vector<std::string> lines;
+  h.Finish(&lines);
+  ASSERT_GE(lines.size(), 7u);
+  EXPECT_EQ(lines[2].find("\"done_at_s\": null"), std::string::npos) << lines[2];  // drop-off 1, delivery 1: done
+  for (int k = 3; k <= 6; ++k) {
+    EXPECT_NE(lines[k].find("\"done_at_s\": null, \"missed\": false"), std::string::npos) << lines[k];
   }
 }
 

@@ -100,7 +100,8 @@ TEST(ObstacleDistanceGridTest, UnknownMarginCountsUnseenSpaceFarther) {
   const ObstacleDistanceGrid margin(g, {true, 0, 1.5});
   EXPECT_EQ(margin.at(6, 0), 3.5f);  // 2 + 1.5, still nearer than the wall (6)
   EXPECT_EQ(margin.at(2, 0), 2.0f);  // walls keep their distance
-  EXPECT_EQ(margin.at(8, 0), 1.5f);  // an unknown cell is the margin away from itself
+  EXPECT_EQ(margin.at(8, 0), 0.0f);  // an unknown cell itself is never entered
+  EXPECT_EQ(margin.at(7, 0), 2.5f);  // 1 + 1.5
   const ObstacleDistanceGrid unknown_free(g, {false, 0, 1.5});
   EXPECT_EQ(unknown_free.at(6, 0), 6.0f);  // the margin only matters when unknown is an obstacle
 }

@@ -50,4 +50,16 @@ inline double Get(const std::string& json, const std::vector<std::string>& keys)
   return std::stod(json.substr(pos + 1));
 }
 
+// The Maze Explorer's bounds on a referee's score.json: completed, no collision, >= 99 % of the
+// reachable free space mapped, mapped walls where true walls are, home within 0.05 m.
+inline void ExpectExploredMappedAndHome(const std::string& j) {
+  ASSERT_FALSE(j.empty());
+  EXPECT_NE(j.find("\"completed\": true"), std::string::npos) << j;
+  EXPECT_EQ(Get(j, {"collisions"}), 0);
+  EXPECT_GE(Get(j, {"map", "coverage"}), 0.99);
+  EXPECT_GE(Get(j, {"map", "wall_precision"}), 0.95);
+  EXPECT_LE(std::hypot(Get(j, {"final_error", "x_m"}), Get(j, {"final_error", "y_m"})), 0.05);
+  for (const char* k : {"time_s", "real_time_factor"}) ::testing::Test::RecordProperty(k, std::to_string(Get(j, {k})));
+}
+
 }  // namespace mbot::app

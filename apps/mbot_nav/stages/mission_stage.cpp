@@ -34,6 +34,9 @@ enum class Task { kWaypoints, kExplore, kWarehouse };
 // first correction the position counts as reached.
 constexpr double kTurnOnlyWithin = 1.5;
 
+// Paths ending this close to the previous one's end lead to the same goal (the stall budget carries on).
+constexpr double kSameGoalM = 0.10;
+
 
 const char* TaskName(Task t) { return t == Task::kWaypoints ? "waypoints" : t == Task::kExplore ? "explore" : "warehouse"; }
 
@@ -117,8 +120,7 @@ class MissionStage : public Stage {
       << ",\n  \"paths\": " << paths_ << ",\n  \"stale_pose_stops\": " << stale_stops_
       << ",\n  \"corrections\": " << total_corrections_ << ",\n  \"stall_recoveries\": " << recoveries_;
     if (o_.task == Task::kWarehouse) {
-      j << ",\n  \"stops\": " << stops_.size() << ",\n  \"stops_done\": " << stop_index_
-        << ",\n  \"localized_at_s\": " << (localized_us_ >= 0 ? Num((localized_us_ - first_slam_us_) * 1e-6) : "null");
+      j << ",\n  \"stops\": " << stops_.size() << ",\n  \"stops_done\": " << stop_index_;
     }
     j << "\n}\n";
     WriteFileAtomically(ctx.output_dir + "/mission.json", [&](std::ostream& out) { out << j.str(); });
@@ -152,12 +154,12 @@ class MissionStage : public Stage {
     }
     if (stuck_since_us_ < 0) stuck_since_us_ = t_us;
     if ((t_us - stuck_since_us_) * 1e-6 < o_.stuck_s) return false;
-    ++recoveries_;
     if (++stalls_this_goal_ > o_.max_stalls) {
       SetState("failed", "stalled " + std::to_string(stalls_this_goal_) + " times on the way to one goal", t_us);
       Send(0, 0, t_us);
       return true;
     }
+    ++recoveries_;
     mbot::log::Warn("mission: stalled for " + Num(o_.stuck_s, 3) + " s while commanded to move: backing off");
     stuck_since_us_ = -1;
     last_command_ = {};
@@ -207,7 +209,6 @@ class MissionStage : public Stage {
       Send(0, 0, t_us);
       return false;
     }
-    if (localized_us_ < 0) localized_us_ = t_us;
     if (!planner_.has_map()) {
       if (!map_) {
         SetState("localizing", "waiting for the known map", t_us);
@@ -223,7 +224,7 @@ class MissionStage : public Stage {
       }
       dwell_until_us_ = -1;
       if (++stop_index_ == stops_.size()) {
-        SetState("completed", std::to_string(warehouse::TotalDeliveries()) + " deliveries made", t_us);
+        SetState("completed", "stood at all " + std::to_string(stops_.size()) + " targets and drop-offs by its own estimate", t_us);
         Send(0, 0, t_us);
         return false;
       }
@@ -250,7 +251,6 @@ class MissionStage : public Stage {
   // The goal is reached and the robot stands at it.
   void Arrived(const std::string& how, int64_t t_us) {
     final_leg_ = false;
-    stalls_this_goal_ = 0;
     if (o_.task != Task::kWarehouse) {
       SetState("completed", std::string(o_.task == Task::kWaypoints ? "circuit driven" : "explored and home") + " (" + how + ")", t_us);
       return;
@@ -286,6 +286,11 @@ class MissionStage : public Stage {
   }
 
   void SetPath(const std::vector<Pose2D>& path, int64_t t_us) {
+    // A new goal (not a replan or a correction towards the same one) gets a fresh stall budget.
+    if (!path.empty() && std::hypot(path.back().x - stall_goal_.x, path.back().y - stall_goal_.y) > kSameGoalM) {
+      stall_goal_ = path.back();
+      stalls_this_goal_ = 0;
+    }
     controller_.SetPath(path);
     ++paths_;
     if (bus_) bus_->Emit(this, drivers::Event{t_us, t_us, "CONTROLLER_PATH", EventKind::kPath, drivers::Path{path}});
@@ -380,7 +385,8 @@ class MissionStage : public Stage {
   size_t stop_index_ = 0;
   planning::AStarPlanner planner_;
   bool need_plan_ = true;
-  int64_t dwell_until_us_ = -1, localized_us_ = -1;
+  int64_t dwell_until_us_ = -1;
+  Pose2D stall_goal_{1e9, 1e9, 0};  // the goal the stall budget is for
   std::string state_ = "initializing", detail_;
   long long commands_ = 0, paths_ = 0, stale_stops_ = 0;
   int corrections_ = 0, total_corrections_ = 0, recoveries_ = 0, stalls_this_goal_ = 0;

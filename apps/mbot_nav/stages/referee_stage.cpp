@@ -6,6 +6,7 @@
 // the score table. Events: speed_run and maze_explorer (SLAM from the start pose: the map frame is
 // the start frame), warehouse (localization in the given map: the map frame is the world frame;
 // deliveries judged from the true pose against warehouse.hpp's rules).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -157,6 +158,7 @@ class RefereeStage : public Stage {
 
     std::vector<Item> items;
     MapQuality mq;
+    int levels_reached = 0;
     if (!warehouse) {
       items.push_back({"final pose", errors(ex, ey, eth) + " from the start" + (completed ? "" : " (not completed)"),
                        completed ? PosePoints(ex, ey, eth) : 0});
@@ -175,20 +177,25 @@ class RefereeStage : public Stage {
                                        errors(sx, sy, sth)
                                  : "global localization never settled",
                        localized && has_slam_error ? PosePoints(sx, sy, sth) : 0});
+      // A delivery is made when its target and its drop-off were both done; it counts at the drop-off.
+      std::vector<double> made_at_s;
+      for (size_t k = 1; k < stop_done_us_.size(); k += 2) {
+        if (stop_done_us_[k - 1] >= 0 && stop_done_us_[k] >= 0) made_at_s.push_back((stop_done_us_[k] - t0_us_) * 1e-6);
+      }
       int needed = 0;
       for (size_t l = 0; l < warehouse::Levels().size(); ++l) {
         const warehouse::Level& level = warehouse::Levels()[l];
         needed += level.deliveries;
-        const size_t last_stop = static_cast<size_t>(2 * needed - 1);  // the drop-off of the level's last delivery
-        const int made = static_cast<int>(done_at_us_.size() / 2);
-        const bool done = done_at_us_.size() > last_stop;
-        const double at_s = done ? (done_at_us_[last_stop] - t0_us_) * 1e-6 : 0.0;
-        const bool in_time = done && at_s <= level.deadline_s;
+        const int in_time = static_cast<int>(
+            std::count_if(made_at_s.begin(), made_at_s.end(), [&](double t) { return t <= level.deadline_s; }));
+        // Levels are climbed in order: a level counts when the ones below it did.
+        const bool reached = in_time >= needed && levels_reached == static_cast<int>(l);
+        if (reached) levels_reached = static_cast<int>(l) + 1;
         items.push_back({"level " + std::to_string(l + 1),
-                         done ? std::to_string(needed) + (needed == 1 ? " delivery by " : " deliveries by ") + Num(at_s, 4) + " s (limit " + Num(level.deadline_s, 4) + " s)"
-                              : std::to_string(std::min(made, needed)) + " of " + std::to_string(needed) + " deliveries",
-                         in_time ? 100 : 0});
-        if (in_time && levels_reached_ == static_cast<int>(l)) levels_reached_ = static_cast<int>(l) + 1;
+                         std::to_string(std::min(in_time, needed)) + " of " + std::to_string(needed) +
+                             (needed == 1 ? " delivery" : " deliveries") + " by " + Num(level.deadline_s, 4) + " s" +
+                             (reached ? " (the last at " + Num(made_at_s[needed - 1], 4) + " s)" : ""),
+                         reached ? 100 : 0});
       }
     }
     int total = 0, max_total = 0;
@@ -212,8 +219,10 @@ class RefereeStage : public Stage {
       << ",\n  \"completed\": " << (completed ? "true" : "false") << ",\n  \"timed_out\": " << (timed_out_ ? "true" : "false")
       << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"time_s\": " << Num(time_s)
       << ",\n  \"sim_seconds\": " << Num(sim_s) << ",\n  \"wall_seconds\": " << Num(wall_s) << ",\n  \"real_time_factor\": " << Num(rtf)
-      << ",\n  \"collisions\": " << collisions_ << ",\n  \"start\": " << PoseJson(start) << ",\n  \"final\": " << PoseJson(final_pose)
-      << ",\n  \"final_error\": {\"x_m\": " << Num(ex) << ", \"y_m\": " << Num(ey) << ", \"theta_deg\": " << Num(eth) << "}";
+      << ",\n  \"collisions\": " << collisions_ << ",\n  \"start\": " << PoseJson(start) << ",\n  \"final\": " << PoseJson(final_pose);
+    if (!warehouse) {  // the robot had to come back to its start
+      j << ",\n  \"final_error\": {\"x_m\": " << Num(ex) << ", \"y_m\": " << Num(ey) << ", \"theta_deg\": " << Num(eth) << "}";
+    }
     if (has_slam_error) {
       j << ",\n  \"slam_final_error\": {\"x_m\": " << Num(sx) << ", \"y_m\": " << Num(sy) << ", \"theta_deg\": " << Num(sth) << "}";
     }
@@ -222,10 +231,11 @@ class RefereeStage : public Stage {
         << ", \"reachable_cells\": " << mq.reachable_cells << ", \"occupied_cells\": " << mq.occupied_cells << "}";
     } else {
       j << ",\n  \"localized_at_s\": " << (localized_us_ >= 0 ? Num((localized_us_ - t0_us_) * 1e-6) : "null")
-        << ",\n  \"levels_reached\": " << levels_reached_ << ",\n  \"stops\": [";
+        << ",\n  \"levels_reached\": " << levels_reached << ",\n  \"stops\": [";
       for (size_t k = 0; k < stops_.size(); ++k) {
         j << (k ? "," : "") << "\n    {\"stop\": " << JsonString(stops_[k].Name()) << ", \"pose\": " << PoseJson(stops_[k].pose)
-          << ", \"done_at_s\": " << (k < done_at_us_.size() ? Num((done_at_us_[k] - t0_us_) * 1e-6) : "null") << "}";
+          << ", \"done_at_s\": " << (k < stop_done_us_.size() && stop_done_us_[k] >= 0 ? Num((stop_done_us_[k] - t0_us_) * 1e-6) : "null")
+          << ", \"missed\": " << (k < stop_done_us_.size() && stop_done_us_[k] < 0 ? "true" : "false") << "}";
       }
       j << "\n  ]";
     }
@@ -253,10 +263,10 @@ class RefereeStage : public Stage {
     }
     WriteFileAtomically(dir + "/score.json", [&](std::ostream& out) { out << j.str(); });
     if (ctx.results) {
-      *ctx.results = {{"event", EventTitle(o_.event)}, {"arena", world_.name()}, {"seed", std::to_string(ctx.seed)},
+      ctx.results->insert(ctx.results->end(), {{"event", EventTitle(o_.event)}, {"arena", world_.name()}, {"seed", std::to_string(ctx.seed)},
                       {"result", result}, {"time_s", Num(time_s, 4)}, {"points", std::to_string(total)},
                       {"max_points", std::to_string(max_total)}, {"collisions", std::to_string(collisions_)},
-                      {"real_time_factor", Num(rtf, 3)}};
+                      {"real_time_factor", Num(rtf, 3)}});
     }
   }
 
@@ -328,24 +338,36 @@ class RefereeStage : public Stage {
     });
   }
 
-  // Warehouse: the next stop counts when the true pose has stayed within the tolerances of it for
-  // the dwell time (stops count in order; a stop the robot skipped holds up the ones after it).
+  // Warehouse: a stop is done when the true pose has stayed within the tolerances of it for the
+  // dwell time. Stops are judged in order; standing at a later stop first marks the ones before it
+  // missed (that delivery fails, the rest still count).
+  static bool Near(const Pose2D& p, const Pose2D& goal) {
+    return std::hypot(p.x - goal.x, p.y - goal.y) <= warehouse::kToleranceM &&
+           std::abs(motion::WrapAngle(p.theta - goal.theta)) * 180.0 / M_PI <= warehouse::kToleranceDeg;
+  }
+
   void JudgeStop(const TimedPose& truth) {
-    if (done_at_us_.size() >= stops_.size()) return;
-    const Pose2D& goal = stops_[done_at_us_.size()].pose;
-    const bool near = std::hypot(truth.pose.x - goal.x, truth.pose.y - goal.y) <= warehouse::kToleranceM &&
-                      std::abs(motion::WrapAngle(truth.pose.theta - goal.theta)) * 180.0 / M_PI <= warehouse::kToleranceDeg;
-    if (!near) {
-      near_since_us_ = -1;
-      return;
+    const size_t next = stop_done_us_.size();  // stops before it are judged (done or missed)
+    // Still standing where the last stop was done: a later stop at the same place (the drop-offs
+    // repeat) must not count until the robot has left.
+    if (!left_last_stop_ && next > 0 && stop_done_us_.back() >= 0) {
+      left_last_stop_ = !Near(truth.pose, stops_[next - 1].pose);
+      if (!left_last_stop_) return;
     }
-    if (near_since_us_ < 0) near_since_us_ = truth.t_us;
-    if ((truth.t_us - near_since_us_) * 1e-6 >= warehouse::kDwellS) {
-      done_at_us_.push_back(truth.t_us);
-      near_since_us_ = -1;
-      mbot::log::Info("referee: " + stops_[done_at_us_.size() - 1].Name() + " done at " +
-                      Num((truth.t_us - t0_us_) * 1e-6, 4) + " s");
+    int at = -1;
+    for (size_t k = next; k < stops_.size() && at < 0; ++k) {
+      if (Near(truth.pose, stops_[k].pose)) at = static_cast<int>(k);
     }
+    if (at != near_stop_) near_stop_ = at, near_since_us_ = truth.t_us;
+    if (at < 0 || (truth.t_us - near_since_us_) * 1e-6 < warehouse::kDwellS) return;
+    for (size_t k = next; k < static_cast<size_t>(at); ++k) {
+      stop_done_us_.push_back(-1);
+      mbot::log::Warn("referee: " + stops_[k].Name() + " missed");
+    }
+    stop_done_us_.push_back(truth.t_us);
+    near_stop_ = -1;
+    left_last_stop_ = false;
+    mbot::log::Info("referee: " + stops_[at].Name() + " done at " + Num((truth.t_us - t0_us_) * 1e-6, 4) + " s");
   }
 
   RefereeOptions o_;
@@ -362,9 +384,10 @@ class RefereeStage : public Stage {
   int64_t localized_us_ = -1;
   // Warehouse.
   std::vector<warehouse::Stop> stops_;
-  std::vector<int64_t> done_at_us_;  // when each stop was done, in order
+  std::vector<int64_t> stop_done_us_;  // per judged stop, in order: when it was done, -1 missed
+  int near_stop_ = -1;                  // the stop the robot stands at, since near_since_us_
+  bool left_last_stop_ = true;          // the robot has moved off the last stop done
   int64_t near_since_us_ = -1;
-  int levels_reached_ = 0;
 };
 
 }  // namespace

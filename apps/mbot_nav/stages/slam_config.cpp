@@ -44,9 +44,13 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
            : mode == "localization" ? mapping::SlamMode::kLocalization
            : mode == "mapping_only" ? mapping::SlamMode::kMappingOnly
                                     : mapping::SlamMode::kActionOnly;
-  o.map_file = s.GetPath("map_file", "", "localization: the known map (any format the map reader knows)");
-  if (m.mode == mapping::SlamMode::kLocalization && o.map_file.empty() && !s.describing()) {
-    s.Fail("map_file", "localization mode needs a map_file");
+  o.map_file = s.GetPath("map_file", "", "localization: the known map (any format the map reader knows, or an .arena)");
+  o.map_from_world = s.GetBool("map_from_world", o.map_from_world,
+                               "localization: the known map is the simulator's world (the source's path), e.g. the "
+                               "Warehouse's given map, so another world brings its own map");
+  if (o.map_from_world && !o.map_file.empty()) s.Fail("map_from_world", "give either map_file or map_from_world, not both");
+  if (m.mode == mapping::SlamMode::kLocalization && o.map_file.empty() && !o.map_from_world && !s.describing()) {
+    s.Fail("map_file", "localization mode needs a map_file (or map_from_world = true)");
   }
 
   // Inputs.

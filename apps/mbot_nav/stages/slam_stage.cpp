@@ -51,6 +51,7 @@ class SlamStage : public Stage {
     bus_ = ctx.bus;
     slam_ = mapping::Slam(options_.slam, ctx.seed);
     noise_rng_.seed(ctx.seed ^ 0x6f646f6dULL);
+    if (options_.map_from_world) options_.map_file = ctx.source_path;
     if (!options_.map_file.empty()) {
       std::string format = "arena walls drawn at " + Num(options_.slam.mapper.resolution_m, 3) + " m";
       // An arena file is a competition's given map (the Warehouse): its walls drawn at the map's resolution.
@@ -265,15 +266,14 @@ class SlamStage : public Stage {
   void Publish(const ScanRecord& r) {
     if (!bus_) return;
     bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_POSE", EventKind::kPoseEstimate, r.slam});
+    const bool mapping = options_.slam.mode != mapping::SlamMode::kLocalization;
     // What the pose is worth, on change: a global search that has not settled gives no usable pose.
-    const bool localizing = options_.slam.mode == mapping::SlamMode::kLocalization;
-    const std::string status = !localizing ? "mapping" : !r.status.converged ? "localizing" : r.status.lost ? "lost" : "localized";
+    const std::string status = mapping ? "mapping" : !r.status.converged ? "localizing" : r.status.lost ? "lost" : "localized";
     if (status != published_status_) {
       published_status_ = status;
       bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_STATUS", EventKind::kStatus,
                                       drivers::Status{status, "spread " + Num(r.status.spread_m, 3) + " m"}});
     }
-    const bool mapping = options_.slam.mode != mapping::SlamMode::kLocalization;
     if (options_.publish_map_every > 0 && (records_.size() == 1 || (mapping && records_.size() % options_.publish_map_every == 0))) {
       bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_MAP", EventKind::kMap,
                                       std::make_shared<const mapping::OccupancyGrid>(slam_.map())});

@@ -1,5 +1,5 @@
 // The Warehouse event's rules, shared by the robot's side (the `mission` stage: what to do) and the
-// judge's (the `referee` stage: what counts), so the two can never disagree. From a seed and the
+// judge's (the `referee` stage: what counts), so the two agree on the stops. From a seed and the
 // arena's `target` and `dropoff` poses they give the ordered stops: each delivery is a target (the
 // crate is lifted: the robot dwells there) and then a drop-off (dwell again). Levels: 1 delivery in
 // the first 3 minutes, 2 more by minute 6, 4 more by minute 12. The forklift is not simulated, so

@@ -160,6 +160,7 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
         if (d <= match_d) match_d = d, match = &f;
       }
       const bool reached = std::hypot(pose.x - path_.back().x, pose.y - path_.back().y) <= options_.target_reached_m;
+      if (!reached) reached_at_s_ = -1;  // pushed or drifted off: the wait starts again on return
       // What the robot saw on the way changed the frontier (part of it was resolved, its centroid
       // moved): the target chosen for the old one may not show the rest, so choose again.
       const bool changed = match && (match_d > kFrontierMovedM || std::abs(match->size() - target_size_) > 0.25 * target_size_);

@@ -26,11 +26,14 @@ ObstacleDistanceGrid::ObstacleDistanceGrid(const mapping::OccupancyGrid& map, co
   const float res = static_cast<float>(resolution_);
   for (float& v : dist_) v = std::sqrt(v) * res;  // sqrt(inf) = inf
   if (!separate_unknown) return;
-  // Unknown space counts as an obstacle unknown_margin_m nearer than it is.
+  // Unknown space counts as an obstacle unknown_margin_m farther than it is; an unknown cell itself
+  // stays at 0, so it is never entered whatever the margin.
   for (size_t i = 0; i < obstacle.size(); ++i) obstacle[i] = map.cells()[i] == 0;
   const std::vector<float> unknown = SquaredDistanceTransform(obstacle, width_, height_);
   const float margin = static_cast<float>(options.unknown_margin_m);
-  for (size_t i = 0; i < dist_.size(); ++i) dist_[i] = std::min(dist_[i], std::sqrt(unknown[i]) * res + margin);
+  for (size_t i = 0; i < dist_.size(); ++i) {
+    dist_[i] = obstacle[i] ? 0.0f : std::min(dist_[i], std::sqrt(unknown[i]) * res + margin);
+  }
 }
 
 void ObstacleDistanceGrid::WorldToCell(double x, double y, int* cx, int* cy) const {

@@ -93,7 +93,8 @@ class World {
 std::vector<uint8_t> ReachableFreeMask(const World& world, const motion::Pose2D& start);
 
 // The world as a known map at `resolution_m` (a competition's given map, e.g. the Warehouse's):
-// cells that a wall overlaps are occupied (+127), cells of the reachable free space (from the world's
+// cells whose centre is within half a cell side of a wall are occupied (+127; what a mapped wall
+// looks like, not every cell a wall grazes), cells of the reachable free space (from the world's
 // `start` pose, or every free cell of a world without one) free (-127), everything else unknown.
 // The map's frame is the world frame.
 mapping::OccupancyGrid RenderKnownMap(const World& world, double resolution_m);

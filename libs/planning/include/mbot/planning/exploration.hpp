@@ -26,7 +26,7 @@ struct ExplorationOptions {
   // when it is still there this long after its target was reached.
   double resolve_wait_s = 1.0;
   double blacklist_s = 30.0;           // how long an unreachable frontier is ignored (one still there
-                                       // when its target is reached is ignored for good)
+                                       // resolve_wait_s after its target was reached is ignored for good)
   double blacklist_radius_m = 0.30;    // frontiers whose centroid lies this close to a blacklisted one
   double frontier_match_m = 0.50;      // the target frontier still exists if a frontier centroid is this close
 };
