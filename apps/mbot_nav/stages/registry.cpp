@@ -10,7 +10,7 @@ const std::vector<StageType>& StageTypes() {
                                    AStarTestStageType(), MovingAiBenchmarkStageType(), ExplorationStageType(),
                                    SlamStageType(), OdometryStageType(), MotorCalibrationStageType(),
                                    ActionModelFitStageType(), MissionStageType(), RefereeStageType(),
-                                   RecorderStageType()};
+                                   RecorderStageType(), LcmBridgeStageType()};
     std::sort(t.begin(), t.end(), [](const StageType& a, const StageType& b) { return a.name < b.name; });
     return t;
   }();

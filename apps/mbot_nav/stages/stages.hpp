@@ -18,5 +18,6 @@ StageType ActionModelFitStageType();
 StageType MissionStageType();
 StageType RefereeStageType();
 StageType RecorderStageType();
+StageType LcmBridgeStageType();
 
 }  // namespace mbot::app

@@ -354,7 +354,24 @@ std::map<int64_t, Entry> BuildTable() {
   add(mbot_legacy::particles_t::getHash(), "particles_t", kLegacy, Other<mbot_legacy::particles_t>(16, 48, "num_particles"));
   add(mbot_legacy::particles_t::getHash(), "particles_t", kW23, nullptr);
   add(mbot_legacy::particles_t::getHash(), "particles_t", kCurrent, nullptr);
-  add(mbot_legacy::robot_path_t::getHash(), "robot_path_t", kLegacy, Other<mbot_legacy::robot_path_t>(16, 20, "path_length"));
+  add(mbot_legacy::robot_path_t::getHash(), "robot_path_t", kLegacy,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        if (!CheckCount(d, n, 16, 20, "path_length", err)) return false;
+        mbot_legacy::robot_path_t m{};
+        if (!DecodeExact(d, n, &m, err)) return false;
+        Path path;
+        for (const auto& p : m.path) {
+          if (!Finite(p.x, p.y, p.theta)) {
+            *err = "non-finite pose in the path";
+            return false;
+          }
+          path.poses.push_back({p.x, p.y, p.theta});
+        }
+        ev->kind = EventKind::kPath;
+        ev->stamp_us = m.utime;
+        ev->payload = std::move(path);
+        return true;
+      });
   add(mbot_legacy::robot_path_t::getHash(), "path2D_t", kCurrent, nullptr);
   add(mbot_legacy::timestamp_t::getHash(), "timestamp_t", kLegacy, Other<mbot_legacy::timestamp_t>());
   add(mbot_legacy::timestamp_t::getHash(), "timestamp_t", kW23, nullptr);
@@ -363,7 +380,21 @@ std::map<int64_t, Entry> BuildTable() {
   add(mbot_legacy::message_received_t::getHash(), "mbot_message_received_t", kCurrent, nullptr);
   add(mbot_legacy::exploration_status_t::getHash(), "exploration_status_t", kLegacy, Other<mbot_legacy::exploration_status_t>());
   add(mbot_legacy::exploration_status_t::getHash(), "exploration_status_t", kW23, nullptr);
-  add(mbot_lcm_msgs::exploration_status_t::getHash(), "exploration_status_t", kCurrent, Other<mbot_lcm_msgs::exploration_status_t>());
+  add(mbot_lcm_msgs::exploration_status_t::getHash(), "exploration_status_t", kCurrent,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        mbot_lcm_msgs::exploration_status_t m{};
+        if (!DecodeExact(d, n, &m, err)) return false;
+        static const char* kStates[] = {"initializing", "exploring", "returning_home", "completed", "failed"};
+        static const char* kStatuses[] = {"in progress", "complete", "failed"};
+        if (m.state < 0 || m.state > 4 || m.status < 0 || m.status > 2) {
+          *err = "state " + std::to_string(m.state) + " / status " + std::to_string(m.status) + " is not one of the botlab's";
+          return false;
+        }
+        ev->kind = EventKind::kStatus;
+        ev->stamp_us = m.utime;
+        ev->payload = Status{kStates[m.state], kStatuses[m.status]};
+        return true;
+      });
   add(mbot_lcm_msgs::slam_status_t::getHash(), "slam_status_t", kCurrent, Other<mbot_lcm_msgs::slam_status_t>());
   add(mbot_lcm_msgs::mbot_slam_reset_t::getHash(), "mbot_slam_reset_t", kCurrent, Other<mbot_lcm_msgs::mbot_slam_reset_t>());
   add(mbot_w23::mbot_system_reset_t::getHash(), "mbot_system_reset_t", kW23, nullptr);
@@ -487,6 +518,52 @@ bool Encode(const Event& ev, std::vector<uint8_t>* out) {
         m.velocity[0] = static_cast<float>(c.a), m.velocity[1] = static_cast<float>(c.b);
         EncodeMessage(m, out);
       }
+      return true;
+    }
+    case EventKind::kMap: {
+      const auto& grid = std::get<std::shared_ptr<const mapping::OccupancyGrid>>(ev.payload);
+      if (!grid) return false;
+      mbot_legacy::occupancy_grid_t m{};  // the 2023+ occupancy_grid_t has the same layout and hash
+      m.utime = ev.stamp_us;
+      m.origin_x = static_cast<float>(grid->origin_x()), m.origin_y = static_cast<float>(grid->origin_y());
+      m.meters_per_cell = static_cast<float>(grid->resolution());
+      m.width = grid->width(), m.height = grid->height();
+      m.num_cells = static_cast<int32_t>(grid->cells().size());
+      m.cells.assign(grid->cells().begin(), grid->cells().end());
+      EncodeMessage(m, out);
+      return true;
+    }
+    case EventKind::kPath: {
+      mbot_legacy::robot_path_t m{};  // = 2023+ path2D_t
+      m.utime = ev.stamp_us;
+      for (const motion::Pose2D& p : std::get<Path>(ev.payload).poses) {
+        m.path.push_back({ev.stamp_us, static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.theta)});
+      }
+      m.path_length = static_cast<int32_t>(m.path.size());
+      EncodeMessage(m, out);
+      return true;
+    }
+    case EventKind::kStatus: {
+      // The botlab's status messages: a task's state as exploration_status_t's constants, SLAM's as
+      // slam_status_t's mode (its own states — localizing, localized, lost — have no field there).
+      const Status& st = std::get<Status>(ev.payload);
+      if (ev.channel == "SLAM_STATUS") {
+        mbot_lcm_msgs::slam_status_t m{};
+        m.utime = ev.stamp_us;
+        m.slam_mode = st.state == "mapping" ? 3 : 2;  // full_slam, localization_only
+        EncodeMessage(m, out);
+        return true;
+      }
+      using X = mbot_lcm_msgs::exploration_status_t;
+      X m{};
+      m.utime = ev.stamp_us;
+      m.state = st.state == "initializing"                                  ? X::STATE_INITIALIZING
+                : st.state == "returning_home" || st.state == "returning home" ? X::STATE_RETURNING_HOME
+                : st.state == "completed"                                   ? X::STATE_COMPLETED_EXPLORATION
+                : st.state == "failed"                                      ? X::STATE_FAILED_EXPLORATION
+                                                                            : X::STATE_EXPLORING_MAP;
+      m.status = st.state == "completed" ? X::STATUS_COMPLETE : st.state == "failed" ? X::STATUS_FAILED : X::STATUS_IN_PROGRESS;
+      EncodeMessage(m, out);
       return true;
     }
     default:

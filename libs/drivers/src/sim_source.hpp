@@ -3,6 +3,7 @@
 // a run goes as fast as the pipeline consumes it.
 #pragma once
 
+#include <chrono>
 #include <memory>
 #include <optional>
 #include <string>
@@ -52,6 +53,8 @@ class SimSource : public Source, public Sink {
   World world_;
   motion::Pose2D start_;
   std::unique_ptr<SimRobot> robot_;
+  double realtime_factor_ = 0;
+  std::chrono::steady_clock::time_point wall0_;
   std::vector<Event> buffer_;
   size_t next_ = 0;
   bool ended_ = false;

@@ -1,4 +1,3 @@
-#include "mbot/common/strings.hpp"
 #include "mbot/drivers/source_options.hpp"
 
 #include <zlib.h>
@@ -11,8 +10,10 @@
 #include <stdexcept>
 
 #include "carmen_source.hpp"
+#include "lcm_live_source.hpp"
 #include "lcm_log_source.hpp"
 #include "mbot/common/config.hpp"
+#include "mbot/common/strings.hpp"
 #include "mbot/drivers/lcm_log.hpp"
 #include "mbot/drivers/map_io.hpp"
 #include "motor_samples_source.hpp"
@@ -78,6 +79,9 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& wo
     s.Fail("start", "required: the world '" + world_path + "' is a map, which names no start pose");
   }
   o.duration_s = s.GetDouble("duration_s", o.duration_s, doc("simulated time after which the run ends [s]"), 0.001, 1e6);
+  o.realtime_factor = s.GetDouble("realtime_factor", o.realtime_factor,
+                                  doc("0: as fast as possible; else simulated time runs this many times the wall clock "
+                                      "(1 for the simulated robot on the LCM bus)"), 0.0, 1000.0);
 
   SimRobotOptions& r = o.robot;
   r.physics_dt_s = s.GetDouble("physics_dt_s", r.physics_dt_s, doc("integration step of the motion [s]"), 1e-4, 0.02);
@@ -129,11 +133,34 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& wo
   return o;
 }
 
+LiveSourceOptions ParseLiveSourceOptions(config::Section& s) {
+  const auto doc = [](const char* text) { return std::string("lcm_live: ") + text; };
+  LiveSourceOptions o;
+  o.channels = s.GetList("channels", o.channels, doc("channels to subscribe to"));
+  o.duration_s = s.GetDouble("duration_s", o.duration_s, doc("the run ends after this long (0: never) [s]"), 0.0, 1e7);
+  o.end_after_silence_s = s.GetDouble("end_after_silence_s", o.end_after_silence_s,
+                                      doc("the run ends when no message arrived for this long (0: never) [s]"), 0.0, 1e7);
+  o.stale_sensor_s = s.GetDouble("stale_sensor_s", o.stale_sensor_s,
+                                 doc("a watched channel silent this long stops the robot [s]"), 0.01, 1e4);
+  o.watched = s.GetList("watched_channels", o.watched, doc("channels whose silence stops the robot"));
+  o.command_channel = s.GetString("command_channel", o.command_channel, doc("velocity commands go out here"));
+  o.report_every_s = s.GetDouble("report_every_s", o.report_every_s, doc("log the loop rate and latency this often (0: never) [s]"), 0.0, 1e6);
+  return o;
+}
+
 SourceOptions ParseSourceOptions(config::Section& s) {
   SourceOptions o;
-  o.type = s.GetChoice("type", o.type, {"auto", "lcm_log", "rawlog", "carmen", "map", "astar_cases", "movingai", "motor_csv", "sim"},
-                       "input format; auto detects it from the file's content (an .arena file is the simulator's world)");
-  o.path = s.RequirePath("path", "the dataset to read (LCM log, MRPT rawlog, CARMEN log, map file, botlab A* poses file or folder, Moving AI .scen), or the simulator's world (.arena or a map)");
+  o.type = s.GetChoice("type", o.type, {"auto", "lcm_log", "rawlog", "carmen", "map", "astar_cases", "movingai", "motor_csv", "sim", "lcm_live"},
+                       "input format; auto detects it from the file's content (an .arena file is the simulator's world); "
+                       "lcm_live: a robot on the LCM bus");
+  const bool live = o.type == "lcm_live";
+  if (live || s.describing()) {
+    o.path = s.GetString("url", kDefaultLcmUrl, "lcm_live: the LCM URL (ttl=0 keeps the traffic on this machine)");
+    o.live = ParseLiveSourceOptions(s);
+  }
+  if (!live) {
+    o.path = s.RequirePath("path", "the dataset to read (LCM log, MRPT rawlog, CARMEN log, map file, botlab A* poses file or folder, Moving AI .scen), or the simulator's world (.arena or a map)");
+  }
   auto& r = o.roles;
   r.odometry = s.GetList("odometry_channels", r.odometry, "LCM channels whose poses are the robot's odometry");
   r.ground_truth = s.GetList("ground_truth_channels", r.ground_truth, "LCM channels carrying ground-truth poses");
@@ -196,6 +223,7 @@ std::unique_ptr<Source> OpenSource(const SourceOptions& options) {
   if (type == "astar_cases" || type == "movingai") return std::make_unique<PlanningCasesSource>(options.path, type);
   if (type == "sim") return std::make_unique<SimSource>(options);
   if (type == "motor_csv") return std::make_unique<MotorSamplesSource>(options.path);
+  if (type == "lcm_live") return std::make_unique<LcmLiveSource>(options);
   throw std::runtime_error("source type '" + type + "' is not known");
 }
 

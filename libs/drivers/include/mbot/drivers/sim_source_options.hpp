@@ -23,6 +23,9 @@ struct SimSourceOptions {
   bool random_start = false;
   double random_start_clearance_m = 0.25;
   double duration_s = 600.0;  // simulated time after which the stream ends
+  // 0: as fast as the pipeline consumes events; > 0: simulated time runs this many times the wall
+  // clock (1: real time, for the simulated robot on the LCM bus).
+  double realtime_factor = 0.0;
   SimRobotOptions robot;
 };
 

@@ -25,9 +25,24 @@ struct ChannelRoles {
   std::vector<std::string> velocity_command = {"MBOT_VEL_CMD"};
 };
 
+// [source] type = lcm_live: a robot (or the simulated one) on the LCM bus, in wall-clock time.
+struct LiveSourceOptions {
+  // The robot's channels the autonomy listens to (current mbot_lcm_msgs names).
+  std::vector<std::string> channels = {"LIDAR", "MBOT_ODOMETRY", "MBOT_ENCODERS", "MBOT_IMU",
+                                       "MBOT_TIMESYNC", "CONTROLLER_PATH", "MBOT_SYSTEM_RESET"};
+  double duration_s = 0.0;             // 0: until Ctrl-C or a stage ends the run
+  double end_after_silence_s = 0.0;    // > 0: the run ends when nothing arrived for this long
+  // A watched channel silent this long is reported and the robot stopped (zero velocity published,
+  // commands held back) until it is back.
+  double stale_sensor_s = 1.0;
+  std::vector<std::string> watched = {"LIDAR", "MBOT_ODOMETRY"};
+  std::string command_channel = "MBOT_VEL_CMD";
+  double report_every_s = 10.0;        // a line with the loop rate and latency this often (0: never)
+};
+
 struct SourceOptions {
-  std::string type = "auto";  // auto, lcm_log, rawlog, carmen, map, astar_cases, movingai, sim
-  std::string path;           // required; for sim, the world file
+  std::string type = "auto";  // auto, lcm_log, rawlog, carmen, map, astar_cases, movingai, sim, lcm_live
+  std::string path;           // required; for sim, the world file; for lcm_live, the LCM URL
   ChannelRoles roles;
   // CARMEN logs with old FLASER lines give no range limit; beams at or beyond it are no-returns.
   double carmen_max_range_m = 81.0;
@@ -39,10 +54,13 @@ struct SourceOptions {
   // The simulator's options: read only when the source is the simulator (type = sim, or auto with
   // an `.arena` path).
   SimSourceOptions sim;
+  LiveSourceOptions live;  // read only when type = lcm_live
 };
 
 // Reads [source]. Throws config::ConfigError naming the key on bad values.
 SourceOptions ParseSourceOptions(config::Section& section);
+// The lcm_live keys of [source].
+LiveSourceOptions ParseLiveSourceOptions(config::Section& section);
 
 // Opens the input named by the options, detecting the format from its content when type = auto.
 // The simulator (type sim) is also a Sink: dynamic_cast the source to drivers::Sink to drive it.

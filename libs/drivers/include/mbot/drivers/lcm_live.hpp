@@ -1,0 +1,65 @@
+// Live LCM: the MBot's own message bus. LcmNode subscribes to channels, decodes and validates every
+// message at the edge (a count that disagrees with the payload, a wrong fingerprint, NaN, a
+// truncated packet is rejected and counted, never passed on) and publishes events as the current
+// mbot_lcm_msgs types. The live source (`[source] type = lcm_live`) is a Source and a Sink built on
+// it; the simulated robot's side uses it through the `lcm_bridge` stage.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mbot/drivers/events.hpp"
+#include "mbot/drivers/source_options.hpp"
+
+namespace mbot::drivers {
+
+inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";  // ttl=0: this machine only
+
+struct LcmChannelStats {
+  long long received = 0;   // messages that arrived
+  long long rejected = 0;   // malformed: not passed on
+  long long unknown = 0;    // of a type nobody knows
+  long long published = 0;  // messages this node sent
+  std::string last_error;   // why the last rejected one was
+};
+
+class LcmNode {
+ public:
+  // Opens `url` and subscribes to `channels` (exact names). Throws std::runtime_error naming the
+  // URL when LCM cannot open it.
+  LcmNode(const std::string& url, const std::vector<std::string>& channels, const ChannelRoles& roles);
+  ~LcmNode();
+  LcmNode(const LcmNode&) = delete;
+  LcmNode& operator=(const LcmNode&) = delete;
+
+  // Waits up to timeout_ms for a message, then takes every message already waiting. Good ones are
+  // appended to `out` in arrival order, t_us = the wall-clock arrival time (µs since the epoch, as
+  // lcm-logger stamps them), stamp_us = the message's utime.
+  void Poll(int timeout_ms, std::vector<Event>* out);
+  // Publishes the event on its channel; false when the event has no LCM message (nothing sent).
+  bool Publish(const Event& event);
+  // Publishes raw bytes (tools and tests that send malformed packets on purpose).
+  void PublishRaw(const std::string& channel, const std::vector<uint8_t>& data);
+
+  const std::map<std::string, LcmChannelStats>& stats() const { return stats_; }
+  long long rejected_total() const;
+  const std::string& url() const { return url_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::string url_;
+  ChannelRoles roles_;
+  std::map<std::string, LcmChannelStats> stats_;
+};
+
+// Wall-clock time in µs since the epoch.
+int64_t WallClockUs();
+
+// The bytes LcmNode::Publish sends for `event` (empty when it has no LCM message).
+std::vector<uint8_t> EncodeEvent(const Event& event);
+
+}  // namespace mbot::drivers

@@ -1,0 +1,97 @@
+#include "mbot/drivers/lcm_live.hpp"
+
+#include <chrono>
+#include <lcm/lcm-cpp.hpp>
+#include <stdexcept>
+
+#include "lcm_messages.hpp"
+#include "mbot/common/log.hpp"
+
+namespace mbot::drivers {
+
+int64_t WallClockUs() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+struct LcmNode::Impl {
+  lcm::LCM lcm;
+  std::vector<Event>* sink = nullptr;  // where the handler puts decoded events during Poll
+  LcmNode* node = nullptr;
+  explicit Impl(const std::string& url) : lcm(url) {}
+
+  void OnMessage(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    LcmChannelStats& s = node->stats_[channel];
+    ++s.received;
+    const auto* data = static_cast<const uint8_t*>(rbuf->data);
+    const size_t size = rbuf->data_size;
+    if (!lcm_adapter::LookUp(lcm_adapter::Fingerprint(data, size))) {
+      ++s.unknown;
+      s.last_error = "unknown fingerprint (or a packet shorter than one)";
+      mbot::log::WarnOnce("lcm_live:unknown:" + channel, "lcm: " + channel + ": message of an unknown type, skipped (counted)");
+      return;
+    }
+    Event ev;
+    std::string error;
+    if (!lcm_adapter::Decode(channel, data, size, node->roles_, &ev, &error)) {
+      ++s.rejected;
+      s.last_error = error;
+      mbot::log::WarnOnce("lcm_live:rejected:" + channel, "lcm: " + channel + ": malformed message rejected (" + error +
+                                                              "); further ones are counted");
+      return;
+    }
+    ev.channel = channel;
+    ev.t_us = WallClockUs();
+    if (sink) sink->push_back(std::move(ev));
+  }
+};
+
+LcmNode::LcmNode(const std::string& url, const std::vector<std::string>& channels, const ChannelRoles& roles)
+    : impl_(std::make_unique<Impl>(url)), url_(url), roles_(roles) {
+  if (!impl_->lcm.good()) throw std::runtime_error("lcm: cannot open '" + url + "'");
+  impl_->node = this;
+  for (const std::string& c : channels) {
+    impl_->lcm.subscribe(c, &Impl::OnMessage, impl_.get());
+    stats_[c];
+  }
+}
+
+LcmNode::~LcmNode() = default;
+
+void LcmNode::Poll(int timeout_ms, std::vector<Event>* out) {
+  impl_->sink = out;
+  // handleTimeout: > 0 handled one message, 0 timed out, < 0 error.
+  int r = impl_->lcm.handleTimeout(timeout_ms);
+  while (r > 0) r = impl_->lcm.handleTimeout(0);
+  impl_->sink = nullptr;
+  if (r < 0) mbot::log::WarnOnce("lcm_live:handle", "lcm: receiving on " + url_ + " failed");
+}
+
+bool LcmNode::Publish(const Event& event) {
+  std::vector<uint8_t> data;
+  if (!lcm_adapter::Encode(event, &data)) return false;
+  if (impl_->lcm.publish(event.channel, data.data(), static_cast<unsigned>(data.size())) != 0) {
+    mbot::log::WarnOnce("lcm_live:publish:" + event.channel, "lcm: publishing " + event.channel + " on " + url_ + " failed");
+    return false;
+  }
+  ++stats_[event.channel].published;
+  return true;
+}
+
+void LcmNode::PublishRaw(const std::string& channel, const std::vector<uint8_t>& data) {
+  impl_->lcm.publish(channel, data.data(), static_cast<unsigned>(data.size()));
+  ++stats_[channel].published;
+}
+
+std::vector<uint8_t> EncodeEvent(const Event& event) {
+  std::vector<uint8_t> data;
+  lcm_adapter::Encode(event, &data);
+  return data;
+}
+
+long long LcmNode::rejected_total() const {
+  long long n = 0;
+  for (const auto& [c, s] : stats_) n += s.rejected + s.unknown;
+  return n;
+}
+
+}  // namespace mbot::drivers
