@@ -73,7 +73,8 @@ TEST(LcmLive, MalformedPacketsOnEverySubscribedChannelAreRejectedAndCountedAndTh
   std::vector<uint8_t> nan_pose = pose;  // x = NaN
   nan_pose[16] = 0x7f, nan_pose[17] = 0xc0, nan_pose[18] = 0, nan_pose[19] = 0;
   robot.PublishRaw("MBOT_ODOMETRY", nan_pose);
-  bad += 2;
+  robot.PublishRaw("MBOT_ODOMETRY", EncodeEvent(Event{0, -5, "MBOT_ODOMETRY", EventKind::kOdometry, motion::Pose2D{1, 2, 0.5}}));
+  bad += 3;  // and a negative utime
   robot.PublishRaw("MBOT_ODOMETRY", pose);  // and one good message: it still passes
   const std::vector<Event> got = Drain(*source, 0.5);
   EXPECT_EQ(source->diagnostics().rejected_messages, bad);

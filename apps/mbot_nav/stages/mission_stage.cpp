@@ -28,7 +28,7 @@ using drivers::EventKind;
 using motion::Pose2D;
 using motion::TimedPose;
 
-enum class Task { kWaypoints, kExplore, kWarehouse };
+enum class Task { kWaypoints, kExplore, kWarehouse, kFollow };
 
 // Within this many final tolerances of the goal, a correction only turns on the spot, and after a
 // first correction the position counts as reached.
@@ -38,7 +38,9 @@ constexpr double kTurnOnlyWithin = 1.5;
 constexpr double kSameGoalM = 0.10;
 
 
-const char* TaskName(Task t) { return t == Task::kWaypoints ? "waypoints" : t == Task::kExplore ? "explore" : "warehouse"; }
+const char* TaskName(Task t) {
+  return t == Task::kWaypoints ? "waypoints" : t == Task::kExplore ? "explore" : t == Task::kWarehouse ? "warehouse" : "follow";
+}
 
 struct MissionOptions {
   Task task = Task::kWaypoints;
@@ -59,6 +61,7 @@ struct MissionOptions {
   double dwell_s = warehouse::kDwellS + 0.5;  // warehouse: standing at a stop (lifting, setting down) [s]
   std::string status_channel = "MISSION_STATUS";
   std::string slam_status_channel = "SLAM_STATUS";
+  std::string path_channel = "CONTROLLER_PATH";  // follow: paths sent by a GUI arrive here
 };
 
 class MissionStage : public Stage {
@@ -98,6 +101,9 @@ class MissionStage : public Stage {
         return;
       case EventKind::kStatus:
         if (ev.channel == o_.slam_status_channel) slam_status_ = std::get<drivers::Status>(ev.payload);
+        return;
+      case EventKind::kPath:
+        if (o_.task == Task::kFollow && ev.channel == o_.path_channel) gui_path_ = std::get<drivers::Path>(ev.payload).poses;
         return;
       case EventKind::kOdometry:
         odometry_.push_back({ev.t_us, std::get<Pose2D>(ev.payload)});
@@ -190,10 +196,11 @@ class MissionStage : public Stage {
       return true;
     }
     ++corrections_, ++total_corrections_;
+    const bool publish = o_.task != Task::kFollow;
     if (!heading_ok && d <= kTurnOnlyWithin * o_.controller.final_tolerance_m) {
-      SetPath({Pose2D{pose.x, pose.y, goal_.theta}}, t_us);
+      SetPath({Pose2D{pose.x, pose.y, goal_.theta}}, t_us, publish);
     } else {
-      SetPath({goal_}, t_us);
+      SetPath({goal_}, t_us, publish);
     }
     return false;
   }
@@ -248,9 +255,30 @@ class MissionStage : public Stage {
     return true;
   }
 
+  // Follow: drive each path a GUI sends on path_channel (the latest replaces the one being driven);
+  // between paths, stand still. False when it has already commanded the robot this step.
+  bool FollowStep(int64_t t_us) {
+    if (!gui_path_.empty()) {
+      goal_ = gui_path_.back();
+      final_leg_ = true;
+      corrections_ = 0;
+      SetPath(gui_path_, t_us, /*publish=*/false);
+      SetState("driving", "a path of " + std::to_string(gui_path_.size()) + " poses from " + o_.path_channel, t_us);
+      gui_path_.clear();
+    }
+    if (final_leg_) return true;
+    if (state_ != "arrived") SetState("waiting", "for a path on " + o_.path_channel, t_us);
+    Send(0, 0, t_us);
+    return false;
+  }
+
   // The goal is reached and the robot stands at it.
   void Arrived(const std::string& how, int64_t t_us) {
     final_leg_ = false;
+    if (o_.task == Task::kFollow) {
+      SetState("arrived", "at the end of the path (" + how + ")", t_us);
+      return;
+    }
     if (o_.task != Task::kWarehouse) {
       SetState("completed", std::string(o_.task == Task::kWaypoints ? "circuit driven" : "explored and home") + " (" + how + ")", t_us);
       return;
@@ -285,7 +313,8 @@ class MissionStage : public Stage {
     if (bus_) bus_->Emit(this, drivers::Event{t_us, t_us, o_.status_channel, EventKind::kStatus, drivers::Status{state, detail}});
   }
 
-  void SetPath(const std::vector<Pose2D>& path, int64_t t_us) {
+  // `publish`: the path goes out on CONTROLLER_PATH (not for a path that came in on it).
+  void SetPath(const std::vector<Pose2D>& path, int64_t t_us, bool publish = true) {
     // A new goal (not a replan or a correction towards the same one) gets a fresh stall budget.
     if (!path.empty() && std::hypot(path.back().x - stall_goal_.x, path.back().y - stall_goal_.y) > kSameGoalM) {
       stall_goal_ = path.back();
@@ -293,7 +322,7 @@ class MissionStage : public Stage {
     }
     controller_.SetPath(path);
     ++paths_;
-    if (bus_) bus_->Emit(this, drivers::Event{t_us, t_us, "CONTROLLER_PATH", EventKind::kPath, drivers::Path{path}});
+    if (bus_ && publish) bus_->Emit(this, drivers::Event{t_us, t_us, o_.path_channel, EventKind::kPath, drivers::Path{path}});
   }
 
   void Send(double v, double w, int64_t t_us) {
@@ -357,6 +386,8 @@ class MissionStage : public Stage {
       }
     } else if (o_.task == Task::kWarehouse && !WarehouseStep(pose, t_us)) {
       return;
+    } else if (o_.task == Task::kFollow && !FollowStep(t_us)) {
+      return;
     }
     if (Recovering(t_us)) return;
     const motion::VelocityCommand c = controller_.Update(Predict(pose), dt);
@@ -381,6 +412,7 @@ class MissionStage : public Stage {
   Pose2D goal_;
   drivers::Status slam_status_;
   // Warehouse.
+  std::vector<Pose2D> gui_path_;  // follow: a path received and not yet taken
   std::vector<warehouse::Stop> stops_;
   size_t stop_index_ = 0;
   planning::AStarPlanner planner_;
@@ -402,10 +434,14 @@ StageType MissionStageType() {
           "driving the motion controller; emits velocity commands, paths and states",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             MissionOptions o;
-            const std::string task = s.GetChoice("task", "waypoints", {"waypoints", "explore", "warehouse"},
-                                                 "follow a circuit of waypoints, explore the unknown and return home, or make "
-                                                 "the Warehouse's deliveries in the known map (the arena's targets and drop-offs)");
-            o.task = task == "explore" ? Task::kExplore : task == "warehouse" ? Task::kWarehouse : Task::kWaypoints;
+            const std::string task = s.GetChoice("task", "waypoints", {"waypoints", "explore", "warehouse", "follow"},
+                                                 "follow a circuit of waypoints, explore the unknown and return home, make "
+                                                 "the Warehouse's deliveries in the known map (the arena's targets and drop-offs), "
+                                                 "or drive the paths a GUI sends on path_channel");
+            o.task = task == "explore"     ? Task::kExplore
+                     : task == "warehouse" ? Task::kWarehouse
+                     : task == "follow"    ? Task::kFollow
+                                           : Task::kWaypoints;
             const std::vector<std::string> w =
                 s.GetList("waypoints", {"arena"},
                           "the circuit: 'arena' (the simulated arena's waypoint poses, relative to its start pose) or "
@@ -453,6 +489,8 @@ StageType MissionStageType() {
             o.dwell_s = s.GetDouble("dwell_s", o.dwell_s, "warehouse: how long to stand at a target or drop-off [s] (the rules ask " +
                                     Num(warehouse::kDwellS, 3) + " s)", 0.0, 600.0);
             o.status_channel = s.GetString("status_channel", o.status_channel, "channel of the status events");
+            o.path_channel = s.GetString("path_channel", o.path_channel,
+                                         "paths go out here; with task = follow, a GUI's paths come in here");
             o.slam_status_channel = s.GetString("slam_status_channel", o.slam_status_channel,
                                                 "channel of SLAM's status (warehouse: drive only once it says localized)");
             return std::make_unique<MissionStage>(o);

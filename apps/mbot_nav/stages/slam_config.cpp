@@ -182,6 +182,8 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
   o.map_basename = s.GetString("map_basename", o.map_basename, "map files in output.dir: .map, .pgm/.yaml, .png, .bt");
   o.png_scale = static_cast<int>(s.GetInt("png_scale", o.png_scale, "pixels per map cell in the PNG", 1, 16));
   o.particles_every = static_cast<int>(s.GetInt("particles_every", o.particles_every, "draw the particles every k-th scan (0: never)", 0));
+  o.publish_particles_every = static_cast<int>(s.GetInt("publish_particles_every", o.publish_particles_every,
+                                                        "emit the particles (SLAM_PARTICLES) every k-th scan (0: never)", 0));
   o.publish_map_every = static_cast<int>(s.GetInt("publish_map_every", o.publish_map_every,
                                                   "emit the map to later stages (planner, explorer) every k-th scan (0: never); the pose goes every scan", 0));
   o.octomap_height_m = s.GetDouble("octomap_height_m", o.octomap_height_m, "wall height in the OctoMap .bt (0: none)", 0.0);

@@ -45,6 +45,7 @@ struct SlamStageOptions {
   std::string map_basename = "slam_map";
   int png_scale = 2;
   int particles_every = 0;              // draw the particles every k-th scan on the PNG (0: never)
+  int publish_particles_every = 0;      // emit SLAM_PARTICLES every k-th scan (0: never)
   int publish_map_every = 5;            // emit the map to later stages every k-th scan (0: never)
   double octomap_height_m = 0.3;        // wall height in the OctoMap (0: no .bt)
 };

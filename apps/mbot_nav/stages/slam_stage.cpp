@@ -274,6 +274,11 @@ class SlamStage : public Stage {
       bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_STATUS", EventKind::kStatus,
                                       drivers::Status{status, "spread " + Num(r.status.spread_m, 3) + " m"}});
     }
+    if (options_.publish_particles_every > 0 && records_.size() % options_.publish_particles_every == 0) {
+      drivers::Particles p;
+      for (const mapping::Particle& q : slam_.filter().particles()) p.poses.push_back(q.pose), p.weights.push_back(q.weight);
+      bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_PARTICLES", EventKind::kParticles, std::move(p)});
+    }
     if (options_.publish_map_every > 0 && (records_.size() == 1 || (mapping && records_.size() % options_.publish_map_every == 0))) {
       bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_MAP", EventKind::kMap,
                                       std::make_shared<const mapping::OccupancyGrid>(slam_.map())});

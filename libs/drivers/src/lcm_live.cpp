@@ -9,6 +9,10 @@
 
 namespace mbot::drivers {
 
+namespace {
+constexpr int64_t kLatestPlausibleUs = 4'102'444'800'000'000;  // 2100-01-01 in µs since the epoch
+}  // namespace
+
 int64_t WallClockUs() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
@@ -37,6 +41,14 @@ struct LcmNode::Impl {
       s.last_error = error;
       mbot::log::WarnOnce("lcm_live:rejected:" + channel, "lcm: " + channel + ": malformed message rejected (" + error +
                                                               "); further ones are counted");
+      return;
+    }
+    // utime is µs on the robot's clock (since boot, or the epoch once time-synced): below zero or
+    // beyond 2100 it is garbage, whatever the payload says.
+    if (ev.stamp_us < 0 || ev.stamp_us > kLatestPlausibleUs) {
+      ++s.rejected;
+      s.last_error = "absurd timestamp utime = " + std::to_string(ev.stamp_us);
+      mbot::log::WarnOnce("lcm_live:time:" + channel, "lcm: " + channel + ": " + s.last_error + "; rejected (further ones are counted)");
       return;
     }
     ev.channel = channel;

@@ -543,6 +543,21 @@ bool Encode(const Event& ev, std::vector<uint8_t>* out) {
       EncodeMessage(m, out);
       return true;
     }
+    case EventKind::kParticles: {
+      const Particles& p = std::get<Particles>(ev.payload);
+      mbot_legacy::particles_t m{};  // = 2023+ particles_t
+      m.utime = ev.stamp_us;
+      for (size_t i = 0; i < p.poses.size(); ++i) {
+        mbot_legacy::particle_t q{};
+        q.pose = {ev.stamp_us, static_cast<float>(p.poses[i].x), static_cast<float>(p.poses[i].y), static_cast<float>(p.poses[i].theta)};
+        q.parent_pose = q.pose;
+        q.weight = i < p.weights.size() ? p.weights[i] : 0.0;
+        m.particles.push_back(q);
+      }
+      m.num_particles = static_cast<int32_t>(m.particles.size());
+      EncodeMessage(m, out);
+      return true;
+    }
     case EventKind::kStatus: {
       // The botlab's status messages: a task's state as exploration_status_t's constants, SLAM's as
       // slam_status_t's mode (its own states — localizing, localized, lost — have no field there).

@@ -244,6 +244,7 @@ const char* ToString(EventKind kind) {
     case EventKind::kPoseEstimate: return "pose estimate";
     case EventKind::kPath: return "path";
     case EventKind::kStatus: return "status";
+    case EventKind::kParticles: return "particles";
     case EventKind::kOther: return "other";
   }
   return "?";

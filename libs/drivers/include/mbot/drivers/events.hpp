@@ -71,6 +71,12 @@ struct Path {
   std::vector<motion::Pose2D> poses;
 };
 
+// The particle filter's samples (SLAM_PARTICLES): poses in the map frame and normalised weights.
+struct Particles {
+  std::vector<motion::Pose2D> poses;
+  std::vector<double> weights;
+};
+
 // What a stage reports about its task (exploration, competition event), botlab-style.
 struct Status {
   std::string state;   // e.g. "exploring", "returning_home", "completed", "failed"
@@ -93,6 +99,7 @@ enum class EventKind {
   kPoseEstimate,   // Pose2D: the stack's own pose estimate (SLAM / localization output)
   kPath,           // Path: the planned path the controller follows
   kStatus,         // Status of a task (exploration, competition event)
+  kParticles,      // Particles: the localization's samples
   kOther,          // recognised but not used by the pipeline (particles, time sync, status …)
 };
 
@@ -100,7 +107,7 @@ const char* ToString(EventKind kind);
 
 using Payload = std::variant<std::monostate, LidarScan, motion::Pose2D, EncoderTicks, Imu,
                              MotorCommand, std::shared_ptr<const mapping::OccupancyGrid>, PlanRequest, WheelSample,
-                             Path, Status>;
+                             Path, Status, Particles>;
 
 struct Event {
   int64_t t_us = 0;       // event (reception / log) time; the order of the stream

@@ -1,0 +1,54 @@
+// The mission stage on a synthetic event stream (no simulator): what it commands and reports.
+#include <gtest/gtest.h>
+
+#include "mbot/common/config.hpp"
+#include "stage.hpp"
+
+namespace mbot::app {
+namespace {
+
+class CaptureBus : public Bus {
+ public:
+  void Emit(const Stage*, const drivers::Event& e) override { events.push_back(e); }
+  void RequestStop(const std::string&) override {}
+  std::vector<drivers::Event> events;
+};
+
+// task = follow (the botlab's motion controller behaviour, live): stand still until a GUI sends a
+// path on CONTROLLER_PATH, then drive it; the path is not published back.
+TEST(MissionFollow, DrivesThePathAGuiSendsAndStandsStillBefore) {
+  auto c = config::Config::FromString("[mission]\ntype = mission\ntask = follow\nstart_delay_s = 0\n");
+  config::Section section = c.GetSection("mission");
+  std::unique_ptr<Stage> mission = FindStageType("mission")->create(section);
+  CaptureBus bus;
+  RunContext ctx{::testing::TempDir(), 1, nullptr, "", &bus};
+  mission->Start(ctx);
+  using drivers::Event;
+  using drivers::EventKind;
+  const motion::Pose2D origin{0, 0, 0};
+  mission->OnEvent(Event{0, 0, "SLAM_POSE", EventKind::kPoseEstimate, origin});
+  int64_t t = 0;
+  auto odometry = [&](double seconds) {
+    for (int i = 0; i < seconds * 50; ++i, t += 20'000) mission->OnEvent(Event{t, t, "MBOT_ODOMETRY", EventKind::kOdometry, origin});
+  };
+  auto max_speed = [&] {
+    double v = 0;
+    for (const Event& e : bus.events) {
+      if (e.kind == EventKind::kMotorCommand) v = std::max(v, std::get<drivers::MotorCommand>(e.payload).a);
+    }
+    return v;
+  };
+  odometry(0.5);
+  EXPECT_EQ(max_speed(), 0.0);
+  bool waiting = false;
+  for (const Event& e : bus.events) waiting = waiting || (e.kind == EventKind::kStatus && std::get<drivers::Status>(e.payload).state == "waiting");
+  EXPECT_TRUE(waiting);
+  bus.events.clear();
+  mission->OnEvent(Event{t, t, "CONTROLLER_PATH", EventKind::kPath, drivers::Path{{{1.0, 0.0, 0.0}}}});
+  odometry(0.5);
+  EXPECT_GT(max_speed(), 0.05);
+  for (const Event& e : bus.events) EXPECT_NE(e.kind, EventKind::kPath) << "the GUI's path was published back";
+}
+
+}  // namespace
+}  // namespace mbot::app
