@@ -22,11 +22,14 @@ unshare -n bash -c '
   ip link set lo up && ip route add 224.0.0.0/4 dev lo || { echo "cannot set up loopback multicast"; exit 1; }
   lcm-logger --quiet --lcm-url="udpm://239.255.76.67:7667?ttl=0" "$out/run.log" > "$out/logger.log" 2>&1 &
   logger=$!
+  trap "kill $logger 2>/dev/null" EXIT
   "$bin" --config "$config/live.ini" --set output.dir="$out/autonomy" --set source.end_after_silence_s=3 \
     --set pipeline.progress=off > "$out/autonomy.log" 2>&1 &
   autonomy=$!
   sleep 1  # the autonomy listens before the robot starts publishing
-  "$bin" --config "$config/sim_robot.ini" --set output.dir="$out/robot" --set pipeline.progress=off > "$out/robot.log" 2>&1
+  # Time limits below ctest'"'"'s 300 s, so a stalled run fails with its logs instead of timing out.
+  "$bin" --config "$config/sim_robot.ini" --set output.dir="$out/robot" --set pipeline.progress=off \
+    --set referee.time_limit_s=150 --set source.duration_s=180 > "$out/robot.log" 2>&1
   robot_rc=$?
   wait $autonomy
   autonomy_rc=$?
@@ -51,6 +54,11 @@ grep -q '"state": "completed"' "$out/autonomy/mission.json" || { echo "FAIL: the
 "$bin" --config "$config/live_replay.ini" --set source.path="$out/run.log" --set output.dir="$out/replay" \
   --set pipeline.progress=off > "$out/replay.log" 2>&1 || { echo "FAIL: the recorded run did not replay"; fail=1; }
 MBOT_LIVE_MAP="$out/autonomy/slam_map.map" MBOT_REPLAY_MAP="$out/replay/slam_map.map" \
-  "$live_tests" --gtest_filter='LiveReplay.*' || { echo "FAIL: the replayed map differs from the live one"; fail=1; }
+  "$live_tests" --gtest_filter='LiveReplay.*' > "$out/replay_check.log" 2>&1
+cat "$out/replay_check.log" | grep -E "agreement|Failure|Expected|Which|actual"
+grep -q '\[  PASSED  \] 1 test' "$out/replay_check.log" || { echo "FAIL: the replayed map differs from the live one"; fail=1; }
+# The autonomy's last report: nothing of the robot's was rejected.
+grep -E "^lcm: [0-9.]+ messages/s" "$out/autonomy.log" | tail -1 | grep -q " 0 rejected" ||
+  { echo "FAIL: the autonomy rejected messages from the simulated robot"; fail=1; }
 [ $fail -eq 0 ] && echo "PASS: explored over LCM, coverage $coverage, no collision; the recorded run replays to the same map"
 exit $fail

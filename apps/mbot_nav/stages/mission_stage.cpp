@@ -1,6 +1,6 @@
 // `mission`: the robot's autonomy after SLAM — what to do (follow a circuit of waypoints, explore
-// and return home, or the Warehouse's deliveries in a known map once global localization has
-// settled), how to get there (A* paths) and the motion controller that turns
+// and return home, the Warehouse's deliveries in a known map once global localization has settled,
+// or drive the paths a GUI sends), how to get there (A* paths) and the motion controller that turns
 // the pose into velocity commands. It runs on every odometry message (the firmware's 50 Hz): the
 // pose is the latest SLAM pose moved on by the odometry since that scan, the command goes out on
 // MBOT_VEL_CMD (to the simulator, or to a robot over LCM). States go out as kStatus events.
@@ -348,8 +348,8 @@ class MissionStage : public Stage {
       Send(0, 0, t_us);
       return;
     }
-    if (state_ == "completed" || state_ == "failed") {
-      Send(0, 0, t_us);
+    if ((state_ == "completed" || state_ == "failed") && !(o_.task == Task::kFollow && !gui_path_.empty())) {
+      Send(0, 0, t_us);  // done (follow: until the next path, which a failure does not end)
       return;
     }
     if (o_.task == Task::kWaypoints) {
@@ -411,8 +411,9 @@ class MissionStage : public Stage {
   bool final_leg_ = false;  // the path ends at goal_, where the robot must stop within the tolerances
   Pose2D goal_;
   drivers::Status slam_status_;
+  // Follow: a path received and not yet taken.
+  std::vector<Pose2D> gui_path_;
   // Warehouse.
-  std::vector<Pose2D> gui_path_;  // follow: a path received and not yet taken
   std::vector<warehouse::Stop> stops_;
   size_t stop_index_ = 0;
   planning::AStarPlanner planner_;

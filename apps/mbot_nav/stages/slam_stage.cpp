@@ -272,7 +272,8 @@ class SlamStage : public Stage {
     if (status != published_status_) {
       published_status_ = status;
       bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_STATUS", EventKind::kStatus,
-                                      drivers::Status{status, "spread " + Num(r.status.spread_m, 3) + " m"}});
+                                      drivers::Status{status, std::string("mode ") + mapping::ToString(options_.slam.mode) +
+                                                                  ", spread " + Num(r.status.spread_m, 3) + " m"}});
     }
     if (options_.publish_particles_every > 0 && records_.size() % options_.publish_particles_every == 0) {
       drivers::Particles p;

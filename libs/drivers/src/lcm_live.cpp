@@ -1,8 +1,12 @@
 #include "mbot/drivers/lcm_live.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
+#include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include <stdexcept>
+#include <thread>
 
 #include "lcm_messages.hpp"
 #include "mbot/common/log.hpp"
@@ -51,8 +55,14 @@ struct LcmNode::Impl {
       mbot::log::WarnOnce("lcm_live:time:" + channel, "lcm: " + channel + ": " + s.last_error + "; rejected (further ones are counted)");
       return;
     }
+    // Our own message coming back (multicast loops back to the sender): not news.
+    const size_t h = std::hash<std::string_view>()(std::string_view(reinterpret_cast<const char*>(data), size));
+    if (node->RecentlyPublished(channel, h)) {
+      ++s.own_echoes;
+      return;
+    }
     ev.channel = channel;
-    ev.t_us = WallClockUs();
+    ev.t_us = rbuf->recv_utime;  // when the receive thread got it (what lcm-logger stamps)
     if (sink) sink->push_back(std::move(ev));
   }
 };
@@ -62,8 +72,14 @@ LcmNode::LcmNode(const std::string& url, const std::vector<std::string>& channel
   if (!impl_->lcm.good()) throw std::runtime_error("lcm: cannot open '" + url + "'");
   impl_->node = this;
   for (const std::string& c : channels) {
-    impl_->lcm.subscribe(c, &Impl::OnMessage, impl_.get());
+    // LCM takes the name as a regular expression: anchor it to this channel alone.
+    std::string exact;
+    for (const char ch : c) exact += std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' ? std::string(1, ch) : std::string("\\") + ch;
+    if (!impl_->lcm.subscribe(exact, &Impl::OnMessage, impl_.get())) {
+      throw std::runtime_error("lcm: cannot subscribe to '" + c + "' on '" + url + "'");
+    }
     stats_[c];
+    subscribed_.insert(c);
   }
 }
 
@@ -75,23 +91,40 @@ void LcmNode::Poll(int timeout_ms, std::vector<Event>* out) {
   int r = impl_->lcm.handleTimeout(timeout_ms);
   while (r > 0) r = impl_->lcm.handleTimeout(0);
   impl_->sink = nullptr;
-  if (r < 0) mbot::log::WarnOnce("lcm_live:handle", "lcm: receiving on " + url_ + " failed");
+  if (r < 0) {
+    mbot::log::WarnOnce("lcm_live:handle", "lcm: receiving on " + url_ + " failed");
+    std::this_thread::sleep_for(std::chrono::milliseconds(timeout_ms));  // do not spin on a broken socket
+  }
 }
 
 bool LcmNode::Publish(const Event& event) {
   std::vector<uint8_t> data;
   if (!lcm_adapter::Encode(event, &data)) return false;
-  if (impl_->lcm.publish(event.channel, data.data(), static_cast<unsigned>(data.size())) != 0) {
-    mbot::log::WarnOnce("lcm_live:publish:" + event.channel, "lcm: publishing " + event.channel + " on " + url_ + " failed");
+  return PublishRaw(event.channel, data);
+}
+
+bool LcmNode::PublishRaw(const std::string& channel, const std::vector<uint8_t>& data) {
+  if (impl_->lcm.publish(channel, data.data(), static_cast<unsigned>(data.size())) != 0) {
+    mbot::log::WarnOnce("lcm_live:publish:" + channel, "lcm: publishing " + channel + " on " + url_ + " failed");
     return false;
   }
-  ++stats_[event.channel].published;
+  ++stats_[channel].published;
+  if (stats_[channel].received > 0 || subscribed(channel)) {  // remember it, to know its echo
+    const size_t h = std::hash<std::string_view>()(std::string_view(reinterpret_cast<const char*>(data.data()), data.size()));
+    auto& recent = recent_[channel];
+    recent.push_back(h);
+    if (recent.size() > kRecentPerChannel) recent.pop_front();
+  }
   return true;
 }
 
-void LcmNode::PublishRaw(const std::string& channel, const std::vector<uint8_t>& data) {
-  impl_->lcm.publish(channel, data.data(), static_cast<unsigned>(data.size()));
-  ++stats_[channel].published;
+bool LcmNode::RecentlyPublished(const std::string& channel, size_t hash) {
+  auto it = recent_.find(channel);
+  if (it == recent_.end()) return false;
+  auto pos = std::find(it->second.begin(), it->second.end(), hash);
+  if (pos == it->second.end()) return false;
+  it->second.erase(pos);
+  return true;
 }
 
 std::vector<uint8_t> EncodeEvent(const Event& event) {
@@ -99,6 +132,8 @@ std::vector<uint8_t> EncodeEvent(const Event& event) {
   lcm_adapter::Encode(event, &data);
   return data;
 }
+
+bool LcmNode::subscribed(const std::string& channel) const { return subscribed_.count(channel) > 0; }
 
 long long LcmNode::rejected_total() const {
   long long n = 0;

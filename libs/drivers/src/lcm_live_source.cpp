@@ -20,52 +20,60 @@ std::string Fixed(double v, int digits) {
 
 LcmLiveSource::LcmLiveSource(const SourceOptions& options)
     : o_(options.live), node_(options.path, options.live.channels, options.roles) {
-  start_us_ = last_message_us_ = last_report_us_ = WallClockUs();
-  for (const std::string& c : o_.watched) last_seen_us_[c] = start_us_;
-  for (const std::string& c : o_.channels) channels_[c] = ChannelInfo{"", "2023+", EventKind::kOther, true};
+  start_ = last_message_ = last_report_ = last_zero_ = Clock::now();
+  for (const std::string& c : o_.watched) last_seen_[c] = start_;
+  for (const std::string& c : o_.channels) channels_[c] = ChannelInfo{"mbot_lcm_msgs", "2023+", EventKind::kOther, true};
   mbot::log::Info("lcm: listening on " + options.path + " to " + std::to_string(o_.channels.size()) + " channels");
 }
 
 std::optional<Event> LcmLiveSource::Next() {
   for (;;) {
-    const int64_t now = WallClockUs();
-    if (o_.duration_s > 0 && now - start_us_ >= static_cast<int64_t>(o_.duration_s * 1e6)) return std::nullopt;
-    if (o_.end_after_silence_s > 0 && now - last_message_us_ >= static_cast<int64_t>(o_.end_after_silence_s * 1e6)) {
-      mbot::log::Info("lcm: nothing arrived for " + Fixed(o_.end_after_silence_s, 1) + " s: ending the run");
+    const Clock::time_point now = Clock::now();  // intervals on the steady clock: a wall-clock step cannot fool them
+    if (o_.duration_s > 0 && now - start_ >= Seconds(o_.duration_s)) {
+      Report(now, true);
       return std::nullopt;
     }
-    Watchdog(now);
-    Report(now, false);
-    if (!queue_.empty()) {
-      Event ev = std::move(queue_.front());
-      queue_.pop_front();
-      // A scan overtaken by a newer one still waiting is stale: drop it rather than fall behind.
-      if (ev.kind == EventKind::kLidar &&
-          std::any_of(queue_.begin(), queue_.end(), [](const Event& e) { return e.kind == EventKind::kLidar; })) {
-        ++dropped_scans_;
-        continue;
-      }
-      latency_ms_.push_back((now - ev.t_us) * 1e-3);
-      ++delivered_;
-      return ev;
+    if (o_.end_after_silence_s > 0 && now - last_message_ >= Seconds(o_.end_after_silence_s)) {
+      mbot::log::Info("lcm: nothing arrived for " + Fixed(o_.end_after_silence_s, 1) + " s: ending the run");
+      Report(now, true);
+      return std::nullopt;
     }
+    // Take what is waiting first, so a newer scan behind the queue is seen before an older one is
+    // processed.
     std::vector<Event> got;
-    node_.Poll(50, &got);
+    node_.Poll(queue_.empty() ? 50 : 0, &got);
     diagnostics_.rejected_messages = node_.rejected_total();
-    if (got.empty()) return Event{now, now, "LIVE_TICK", EventKind::kOther, {}};
     for (Event& e : got) {
-      last_message_us_ = e.t_us;
-      if (last_seen_us_.count(e.channel)) last_seen_us_[e.channel] = e.t_us;
+      last_message_ = Clock::now();
+      if (last_seen_.count(e.channel)) last_seen_[e.channel] = last_message_;
       channels_[e.channel].kind = e.kind;
       queue_.push_back(std::move(e));
     }
+    Watchdog(Clock::now());
+    Report(Clock::now(), false);
+    if (queue_.empty()) {
+      const int64_t t = WallClockUs();
+      return Event{t, t, "LIVE_TICK", EventKind::kOther, {}};  // lets the pipeline check its stop flag
+    }
+    Event ev = std::move(queue_.front());
+    queue_.pop_front();
+    // A scan overtaken by a newer one is stale: drop it rather than fall behind.
+    if (ev.kind == EventKind::kLidar &&
+        std::any_of(queue_.begin(), queue_.end(), [](const Event& e) { return e.kind == EventKind::kLidar; })) {
+      ++dropped_scans_;
+      continue;
+    }
+    latency_ms_.push_back((WallClockUs() - ev.t_us) * 1e-3);
+    if (latency_ms_.size() >= kMaxLatencySamples) Report(Clock::now(), true);
+    ++delivered_;
+    return ev;
   }
 }
 
-void LcmLiveSource::Watchdog(int64_t now_us) {
+void LcmLiveSource::Watchdog(Clock::time_point now) {
   std::string silent;
-  for (const auto& [channel, seen] : last_seen_us_) {
-    if (now_us - seen > static_cast<int64_t>(o_.stale_sensor_s * 1e6)) silent += (silent.empty() ? "" : ", ") + channel;
+  for (const auto& [channel, seen] : last_seen_) {
+    if (now - seen > Seconds(o_.stale_sensor_s)) silent += (silent.empty() ? "" : ", ") + channel;
   }
   if (!silent.empty() && !halted_) {
     halted_ = true;
@@ -76,15 +84,17 @@ void LcmLiveSource::Watchdog(int64_t now_us) {
     halted_ = false;
     mbot::log::Info("lcm: sensors back: commands pass again");
   }
-  if (halted_) {
-    const int64_t t = now_us;
+  // While halted, zero velocity goes out at kZeroRateHz (the firmware keeps the last command).
+  if (halted_ && now - last_zero_ >= Seconds(1.0 / kZeroRateHz)) {
+    last_zero_ = now;
+    const int64_t t = WallClockUs();
     node_.Publish(Event{t, t, o_.command_channel, EventKind::kMotorCommand, MotorCommand{MotorCommand::Kind::kVelocity, 0, 0}});
   }
 }
 
 void LcmLiveSource::Send(const Event& event) {
   Event out = event;
-  out.stamp_us = WallClockUs();  // outgoing messages carry the time they were sent
+  if (out.stamp_us == 0) out.stamp_us = WallClockUs();
   if (event.kind == EventKind::kMotorCommand && event.channel == o_.command_channel && halted_) {
     ++held_commands_;
     out.payload = MotorCommand{MotorCommand::Kind::kVelocity, 0, 0};
@@ -92,27 +102,30 @@ void LcmLiveSource::Send(const Event& event) {
   node_.Publish(out);
 }
 
-void LcmLiveSource::Report(int64_t now_us, bool force) {
-  if (!force && (o_.report_every_s <= 0 || now_us - last_report_us_ < static_cast<int64_t>(o_.report_every_s * 1e6))) return;
-  const double span_s = (now_us - last_report_us_) * 1e-6;
+void LcmLiveSource::Report(Clock::time_point now, bool force) {
+  const bool due = o_.report_every_s > 0 && now - last_report_ >= Seconds(o_.report_every_s);
+  if (!force && !due) return;
+  const double span_s = std::chrono::duration<double>(now - last_report_).count();
   last_rate_hz_ = span_s > 0 ? (delivered_ - delivered_at_report_) / span_s : 0.0;
   if (!latency_ms_.empty()) {
     std::sort(latency_ms_.begin(), latency_ms_.end());
     last_latency_median_ms_ = latency_ms_[latency_ms_.size() / 2];
     last_latency_max_ms_ = latency_ms_.back();
   }
-  mbot::log::Info("lcm: " + Fixed(last_rate_hz_, 1) + " messages/s processed, arrival-to-processing latency median " +
-                  Fixed(last_latency_median_ms_, 2) + " ms, max " + Fixed(last_latency_max_ms_, 2) + " ms; " +
-                  std::to_string(node_.rejected_total()) + " rejected, " + std::to_string(dropped_scans_) +
-                  " stale scans dropped, " + std::to_string(halts_) + " sensor stops");
+  if (o_.report_every_s > 0) {
+    mbot::log::Info("lcm: " + Fixed(last_rate_hz_, 1) + " messages/s processed, arrival-to-processing latency median " +
+                    Fixed(last_latency_median_ms_, 2) + " ms, max " + Fixed(last_latency_max_ms_, 2) + " ms; " +
+                    std::to_string(node_.rejected_total()) + " rejected, " + std::to_string(dropped_scans_) +
+                    " stale scans dropped, " + std::to_string(halts_) + " sensor stops");
+  }
   latency_ms_.clear();
   delivered_at_report_ = delivered_;
-  last_report_us_ = now_us;
+  last_report_ = now;
 }
 
 double LcmLiveSource::Progress() const {
   if (o_.duration_s <= 0) return 0.0;
-  return std::min(1.0, (WallClockUs() - start_us_) * 1e-6 / o_.duration_s);
+  return std::min(1.0, std::chrono::duration<double>(Clock::now() - start_).count() / o_.duration_s);
 }
 
 std::vector<std::pair<std::string, std::string>> LcmLiveSource::Details() const {
@@ -127,6 +140,7 @@ std::vector<std::pair<std::string, std::string>> LcmLiveSource::Details() const 
       {"latency", "median " + Fixed(last_latency_median_ms_, 2) + " ms, max " + Fixed(last_latency_max_ms_, 2) + " ms"}};
   for (const auto& [channel, s] : node_.stats()) {
     if (s.rejected + s.unknown > 0) d.push_back({"rejected on " + channel, std::to_string(s.rejected + s.unknown) + " (" + s.last_error + ")"});
+    if (s.own_echoes > 0) d.push_back({"own messages looped back on " + channel, std::to_string(s.own_echoes)});
   }
   return d;
 }

@@ -1,11 +1,15 @@
 // `[source] type = lcm_live`: the autonomy's side of a robot on the LCM bus, as a Source (the
-// robot's sensor messages, validated at the edge) and a Sink (velocity commands, SLAM pose and map,
-// paths and statuses published as the botlab's messages). Time is the wall clock: t_us is when a
-// message arrived. A scan that a newer one overtook in the queue is dropped, not processed late. A
-// watched sensor (LIDAR, MBOT_ODOMETRY) silent for stale_sensor_s is reported and the robot stopped:
-// zero velocity is published and the stack's commands are held back until it is back.
+// robot's sensor messages, validated at the edge) and a Sink (velocity commands, SLAM pose, map and
+// particles, paths and statuses published as the botlab's messages). Time is the wall clock: t_us
+// is when LCM's receive thread got a message. Whatever is waiting is taken before the next event is
+// delivered, and a scan a newer one overtook is dropped, not processed late. A watched sensor
+// (LIDAR, MBOT_ODOMETRY) silent for stale_sensor_s is reported and the robot stopped: zero velocity
+// goes out at 10 Hz and the stack's commands are held back until it is back. The watchdog runs
+// between events, so a stage that blocks for long also delays it (a watchdog thread of its own
+// would close that gap).
 #pragma once
 
+#include <chrono>
 #include <deque>
 #include <map>
 #include <optional>
@@ -32,18 +36,25 @@ class LcmLiveSource : public Source, public Sink {
   void Send(const Event& event) override;
 
  private:
-  void Watchdog(int64_t now_us);
-  void Report(int64_t now_us, bool force);
+  using Clock = std::chrono::steady_clock;
+  static Clock::duration Seconds(double s) {
+    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
+  }
+  static constexpr double kZeroRateHz = 10.0;          // zero velocity while halted
+  static constexpr size_t kMaxLatencySamples = 100000;  // a report (and a fresh window) at the latest then
+
+  void Watchdog(Clock::time_point now);
+  void Report(Clock::time_point now, bool force);
 
   LiveSourceOptions o_;
   LcmNode node_;
   std::deque<Event> queue_;
-  int64_t start_us_ = 0, last_message_us_ = 0, last_report_us_ = 0;
-  std::map<std::string, int64_t> last_seen_us_;  // watched channels
-  bool halted_ = false;                          // a watched sensor is silent: commands held back
+  Clock::time_point start_, last_message_, last_report_, last_zero_;
+  std::map<std::string, Clock::time_point> last_seen_;  // watched channels
+  bool halted_ = false;                                 // a watched sensor is silent: commands held back
   long long halts_ = 0, held_commands_ = 0, dropped_scans_ = 0, delivered_ = 0;
   long long delivered_at_report_ = 0;
-  std::vector<double> latency_ms_;  // arrival to delivery, since the last report
+  std::vector<double> latency_ms_;  // arrival (LCM's receive thread) to delivery, since the last report
   double last_rate_hz_ = 0, last_latency_median_ms_ = 0, last_latency_max_ms_ = 0;
 };
 

@@ -171,6 +171,10 @@ Decoder Other(size_t count_offset = 0, size_t element_bytes = 0, const char* fie
   };
 }
 
+// exploration_status_t's STATE_* and STATUS_* constants by value, as this stack's state names.
+const char* const kExplorationStates[] = {"initializing", "exploring", "returning_home", "completed", "failed"};
+const char* const kExplorationStatuses[] = {"in progress", "complete", "failed"};
+
 std::map<int64_t, Entry> BuildTable() {
   std::map<int64_t, Entry> t;
   auto add = [&t](int64_t hash, const std::string& type, const std::string& gen, Decoder dec) {
@@ -384,15 +388,13 @@ std::map<int64_t, Entry> BuildTable() {
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
         mbot_lcm_msgs::exploration_status_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
-        static const char* kStates[] = {"initializing", "exploring", "returning_home", "completed", "failed"};
-        static const char* kStatuses[] = {"in progress", "complete", "failed"};
         if (m.state < 0 || m.state > 4 || m.status < 0 || m.status > 2) {
           *err = "state " + std::to_string(m.state) + " / status " + std::to_string(m.status) + " is not one of the botlab's";
           return false;
         }
         ev->kind = EventKind::kStatus;
         ev->stamp_us = m.utime;
-        ev->payload = Status{kStates[m.state], kStatuses[m.status]};
+        ev->payload = Status{kExplorationStates[m.state], kExplorationStatuses[m.status]};
         return true;
       });
   add(mbot_lcm_msgs::slam_status_t::getHash(), "slam_status_t", kCurrent, Other<mbot_lcm_msgs::slam_status_t>());
@@ -562,22 +564,27 @@ bool Encode(const Event& ev, std::vector<uint8_t>* out) {
       // The botlab's status messages: a task's state as exploration_status_t's constants, SLAM's as
       // slam_status_t's mode (its own states — localizing, localized, lost — have no field there).
       const Status& st = std::get<Status>(ev.payload);
-      if (ev.channel == "SLAM_STATUS") {
+      if (ev.channel == "SLAM_STATUS") {  // the slam stage's detail names the mode: "mode <name>, ..."
         mbot_lcm_msgs::slam_status_t m{};
         m.utime = ev.stamp_us;
-        m.slam_mode = st.state == "mapping" ? 3 : 2;  // full_slam, localization_only
+        const auto has = [&](const char* mode) { return st.detail.find(std::string("mode ") + mode) != std::string::npos; };
+        m.slam_mode = has("mapping-only") ? 0 : has("action-only") ? 1 : has("localization") ? 2 : 3;
         EncodeMessage(m, out);
         return true;
       }
+      // Any other task state: the nearest exploration state (a state of its own, e.g. "driving" or
+      // "lifting", is one in progress).
       using X = mbot_lcm_msgs::exploration_status_t;
       X m{};
       m.utime = ev.stamp_us;
-      m.state = st.state == "initializing"                                  ? X::STATE_INITIALIZING
-                : st.state == "returning_home" || st.state == "returning home" ? X::STATE_RETURNING_HOME
-                : st.state == "completed"                                   ? X::STATE_COMPLETED_EXPLORATION
-                : st.state == "failed"                                      ? X::STATE_FAILED_EXPLORATION
-                                                                            : X::STATE_EXPLORING_MAP;
-      m.status = st.state == "completed" ? X::STATUS_COMPLETE : st.state == "failed" ? X::STATUS_FAILED : X::STATUS_IN_PROGRESS;
+      m.state = X::STATE_EXPLORING_MAP;
+      for (int8_t k = 0; k < 5; ++k) {
+        if (st.state == kExplorationStates[k]) m.state = k;
+      }
+      if (st.state == "returning home") m.state = X::STATE_RETURNING_HOME;  // the explorer's own spelling
+      m.status = m.state == X::STATE_COMPLETED_EXPLORATION ? X::STATUS_COMPLETE
+                 : m.state == X::STATE_FAILED_EXPLORATION  ? X::STATUS_FAILED
+                                                           : X::STATUS_IN_PROGRESS;
       EncodeMessage(m, out);
       return true;
     }

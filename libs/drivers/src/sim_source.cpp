@@ -43,8 +43,7 @@ SimSource::SimSource(const SourceOptions& options)
       world_(World::Load(options.path)),
       start_(StartPose(options, world_)),
       robot_(MakeRobot(options, world_, start_)),
-      realtime_factor_(options.sim.realtime_factor),
-      wall0_(std::chrono::steady_clock::now()) {
+      realtime_factor_(options.sim.realtime_factor) {
   const std::string gen = "simulated";
   channels_[sim_channel::kEncoders] = ChannelInfo{"mbot_encoders_t", gen, EventKind::kEncoders, true};
   channels_[sim_channel::kImu] = ChannelInfo{"mbot_imu_t", gen, EventKind::kImu, true};
@@ -63,9 +62,9 @@ std::optional<Event> SimSource::Next() {
     const int64_t now = robot_->now_us();
     if (ended_ || now >= duration_us_) return std::nullopt;
     const int64_t step = std::max<int64_t>(1, std::llround(robot_->options().physics_dt_s * 1e6));
-    if (realtime_factor_ > 0) {  // keep simulated time with the wall clock
-      const auto due = wall0_ + std::chrono::microseconds(static_cast<int64_t>(now / realtime_factor_));
-      std::this_thread::sleep_until(due);
+    if (realtime_factor_ > 0) {  // keep simulated time with the wall clock, from the first event asked for
+      if (!paced_) paced_ = true, wall0_ = std::chrono::steady_clock::now() - std::chrono::microseconds(static_cast<int64_t>(now / realtime_factor_));
+      std::this_thread::sleep_until(wall0_ + std::chrono::microseconds(static_cast<int64_t>(now / realtime_factor_)));
     }
     robot_->AdvanceTo(std::min(now + step, duration_us_), &buffer_);
   }

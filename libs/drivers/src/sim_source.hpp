@@ -1,6 +1,7 @@
 // The simulator as a source and a sink: a SimRobot on a World, stepped in simulated time as events
 // are asked for, driven by the velocity commands sent back to it. Time comes from the simulation, so
-// a run goes as fast as the pipeline consumes it.
+// a run goes as fast as the pipeline consumes it, or, with realtime_factor > 0, that many times the
+// wall clock (the simulated robot on the LCM bus).
 #pragma once
 
 #include <chrono>
@@ -54,7 +55,8 @@ class SimSource : public Source, public Sink {
   motion::Pose2D start_;
   std::unique_ptr<SimRobot> robot_;
   double realtime_factor_ = 0;
-  std::chrono::steady_clock::time_point wall0_;
+  bool paced_ = false;
+  std::chrono::steady_clock::time_point wall0_;  // wall time of simulated time 0
   std::vector<Event> buffer_;
   size_t next_ = 0;
   bool ended_ = false;

@@ -82,6 +82,7 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& wo
   o.realtime_factor = s.GetDouble("realtime_factor", o.realtime_factor,
                                   doc("0: as fast as possible; else simulated time runs this many times the wall clock "
                                       "(1 for the simulated robot on the LCM bus)"), 0.0, 1000.0);
+  if (o.realtime_factor > 0 && o.realtime_factor < 0.01) s.Fail("realtime_factor", "must be 0 (off) or at least 0.01");
 
   SimRobotOptions& r = o.robot;
   r.physics_dt_s = s.GetDouble("physics_dt_s", r.physics_dt_s, doc("integration step of the motion [s]"), 1e-4, 0.02);

@@ -100,7 +100,7 @@ enum class EventKind {
   kPath,           // Path: the planned path the controller follows
   kStatus,         // Status of a task (exploration, competition event)
   kParticles,      // Particles: the localization's samples
-  kOther,          // recognised but not used by the pipeline (particles, time sync, status …)
+  kOther,          // recognised but not used by the pipeline (time sync, resets, legacy particles …)
 };
 
 const char* ToString(EventKind kind);
