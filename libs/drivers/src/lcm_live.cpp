@@ -32,6 +32,12 @@ struct LcmNode::Impl {
     ++s.received;
     const auto* data = static_cast<const uint8_t*>(rbuf->data);
     const size_t size = rbuf->data_size;
+    // Our own message coming back (multicast loops back to the sender): not news.
+    const size_t h = std::hash<std::string_view>()(std::string_view(reinterpret_cast<const char*>(data), size));
+    if (node->RecentlyPublished(channel, h)) {
+      ++s.own_echoes;
+      return;
+    }
     if (!lcm_adapter::LookUp(lcm_adapter::Fingerprint(data, size))) {
       ++s.unknown;
       s.last_error = "unknown fingerprint (or a packet shorter than one)";
@@ -53,12 +59,6 @@ struct LcmNode::Impl {
       ++s.rejected;
       s.last_error = "absurd timestamp utime = " + std::to_string(ev.stamp_us);
       mbot::log::WarnOnce("lcm_live:time:" + channel, "lcm: " + channel + ": " + s.last_error + "; rejected (further ones are counted)");
-      return;
-    }
-    // Our own message coming back (multicast loops back to the sender): not news.
-    const size_t h = std::hash<std::string_view>()(std::string_view(reinterpret_cast<const char*>(data), size));
-    if (node->RecentlyPublished(channel, h)) {
-      ++s.own_echoes;
       return;
     }
     ev.channel = channel;
