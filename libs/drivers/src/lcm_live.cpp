@@ -109,7 +109,7 @@ bool LcmNode::PublishRaw(const std::string& channel, const std::vector<uint8_t>&
     return false;
   }
   ++stats_[channel].published;
-  if (stats_[channel].received > 0 || subscribed(channel)) {  // remember it, to know its echo
+  if (subscribed(channel)) {  // remember it, to know its echo
     const size_t h = std::hash<std::string_view>()(std::string_view(reinterpret_cast<const char*>(data.data()), data.size()));
     auto& recent = recent_[channel];
     recent.push_back(h);
