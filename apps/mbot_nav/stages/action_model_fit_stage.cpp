@@ -17,7 +17,7 @@
 #include "mbot/common/log.hpp"
 #include "mbot/motion/action_model_fit.hpp"
 #include "mbot/motion/wheel_odometry.hpp"
-#include "motion_config.hpp"
+#include "mbot/motion/motion_config.hpp"
 #include "report.hpp"
 #include "stages.hpp"
 
@@ -171,7 +171,7 @@ StageType ActionModelFitStageType() {
             o.encoder_odometry = s.GetChoice("odometry", "channel", {"channel", "encoders"},
                                              "odometry from an odometry channel or integrated from encoder ticks") == "encoders";
             o.odometry_channel = s.GetString("odometry_channel", "", "odometry channel ('' = the first one seen)");
-            o.wheels = ParseWheelConstants(s);
+            o.wheels = motion::ParseWheelConstants(s);
             o.max_truth_gap_s = s.GetDouble("max_truth_gap_s", o.max_truth_gap_s, "ground truth is interpolated across gaps up to this [s]", 0.0);
             o.odometry_on_stamps = s.GetChoice("clock", "event", {"event", "stamp"},
                                                "place odometry by when it was logged (as the ground truth) or by its own stamps (offset to the log clock)") == "stamp";

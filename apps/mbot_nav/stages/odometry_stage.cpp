@@ -12,7 +12,7 @@
 #include "mbot/drivers/map_io.hpp"
 #include "mbot/motion/gyrodometry.hpp"
 #include "mbot/motion/trajectory_error.hpp"
-#include "motion_config.hpp"
+#include "mbot/motion/motion_config.hpp"
 #include "report.hpp"
 #include "stages.hpp"
 
@@ -151,7 +151,7 @@ StageType OdometryStageType() {
   return {"odometry", "recomputes dead reckoning from encoders and IMU (encoders, gyrodometry, complementary, IMU yaw) and scores it against ground truth",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             OdometryStageOptions o;
-            o.wheels = ParseWheelConstants(s);
+            o.wheels = motion::ParseWheelConstants(s);
             o.headings = s.GetList("headings", o.headings, "heading modes to run: encoders, gyrodometry, complementary, imu_yaw");
             for (const auto& h : o.headings) {
               if (!kHeadings.count(h)) s.Fail("headings", "unknown heading mode '" + h + "' (encoders, gyrodometry, complementary, imu_yaw)");

@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "mbot/common/config.hpp"
-#include "motion_config.hpp"
+#include "mbot/motion/motion_config.hpp"
 
 namespace mbot::app {
 namespace {
@@ -44,13 +44,9 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
            : mode == "localization" ? mapping::SlamMode::kLocalization
            : mode == "mapping_only" ? mapping::SlamMode::kMappingOnly
                                     : mapping::SlamMode::kActionOnly;
-  o.map_file = s.GetPath("map_file", "", "localization: the known map (any format the map reader knows, or an .arena)");
-  o.map_from_world = s.GetBool("map_from_world", o.map_from_world,
-                               "localization: the known map is the simulator's world (the source's path), e.g. the "
-                               "Warehouse's given map, so another world brings its own map");
-  if (o.map_from_world && !o.map_file.empty()) s.Fail("map_from_world", "give either map_file or map_from_world, not both");
-  if (m.mode == mapping::SlamMode::kLocalization && o.map_file.empty() && !o.map_from_world && !s.describing()) {
-    s.Fail("map_file", "localization mode needs a map_file (or map_from_world = true)");
+  o.map_file = s.GetPath("map_file", "", "localization: the known map (any format the map reader knows)");
+  if (m.mode == mapping::SlamMode::kLocalization && o.map_file.empty() && !s.describing()) {
+    s.Fail("map_file", "localization mode needs a map_file");
   }
 
   // Inputs.
@@ -59,7 +55,7 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
                                       "odometry from an odometry channel or integrated from encoder ticks");
   o.encoder_odometry = odo == "encoders";
   o.odometry_channel = s.GetString("odometry_channel", "", "odometry channel ('' = the first one seen)");
-  o.wheels = ParseWheelConstants(s);  // used when odometry = encoders
+  o.wheels = motion::ParseWheelConstants(s);  // used when odometry = encoders
   o.ground_truth_channel = s.GetString("ground_truth_channel", "", "ground-truth channel ('' = the first one seen)");
   o.reference_channel = s.GetString("reference_channel", "", "reference-pose channel ('' = the first one seen)");
   o.mapping_poses_from_reference =

@@ -320,6 +320,51 @@ std::vector<std::string> Section::GetList(const std::string& key, const std::vec
   return out;
 }
 
+namespace {
+
+std::string PoseText(const PoseValue& p) {
+  std::ostringstream o;
+  o << p.x_m << ", " << p.y_m << ", " << p.theta_rad * 180.0 / M_PI;
+  return o.str();
+}
+
+}  // namespace
+
+std::vector<PoseValue> Section::GetPoses(const std::string& key, const std::vector<PoseValue>& def,
+                                         const std::string& doc) {
+  std::vector<std::string> texts;
+  for (const PoseValue& p : def) texts.push_back(PoseText(p));
+  const Entry* e = Find(key, "poses", Join(texts, "; "), false, doc + " (x, y, theta_deg per pose; poses separated by ';')");
+  if (!e) return def;
+  std::string text = e->value;
+  std::replace(text.begin(), text.end(), ';', ',');
+  std::vector<double> numbers;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    item = Trim(item);
+    if (item.empty()) continue;
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (*end != '\0' || !std::isfinite(v) || std::abs(v) > 1e6) {
+      Fail(key, "'" + item + "' is not a finite number of at most 1e6 (expected x, y, theta_deg per pose)");
+    }
+    numbers.push_back(v);
+  }
+  if (numbers.size() % 3 != 0) {
+    Fail(key, std::to_string(numbers.size()) + " numbers do not make x, y, theta_deg triples");
+  }
+  std::vector<PoseValue> poses;
+  for (size_t i = 0; i + 2 < numbers.size(); i += 3) poses.push_back({numbers[i], numbers[i + 1], numbers[i + 2] * M_PI / 180.0});
+  return poses;
+}
+
+PoseValue Section::GetPose(const std::string& key, const PoseValue& def, const std::string& doc) {
+  const std::vector<PoseValue> poses = GetPoses(key, {def}, doc);
+  if (poses.size() != 1) Fail(key, "expected one pose, x, y, theta_deg");
+  return poses[0];
+}
+
 std::string Section::GetChoice(const std::string& key, const std::string& def,
                                const std::vector<std::string>& choices, const std::string& doc) {
   const Entry* e = Find(key, "string", def, false, doc + " (one of: " + Join(choices, ", ") + ")");

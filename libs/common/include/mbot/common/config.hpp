@@ -8,6 +8,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mbot::config {
@@ -40,6 +41,14 @@ struct KeyDoc {
 };
 
 class Section;
+
+// A planar pose read from a configuration key. In INI files every pose is written
+// `x, y, theta_deg`: metres, metres, degrees counter-clockwise (converted to radians here).
+struct PoseValue {
+  double x_m = 0.0;
+  double y_m = 0.0;
+  double theta_rad = 0.0;
+};
 
 // The effective configuration after includes and overrides.
 class Config {
@@ -104,6 +113,28 @@ class Section {
   // One of `choices`; anything else is an error listing them.
   std::string GetChoice(const std::string& key, const std::string& def,
                         const std::vector<std::string>& choices, const std::string& doc);
+
+  // One pose, `x, y, theta_deg` (see PoseValue).
+  PoseValue GetPose(const std::string& key, const PoseValue& def, const std::string& doc);
+  // Poses, `x, y, theta_deg` each, separated by `;` (or all by commas, in threes).
+  std::vector<PoseValue> GetPoses(const std::string& key, const std::vector<PoseValue>& def,
+                                  const std::string& doc);
+  // One of an enum's names; anything else is an error listing them.
+  template <typename E>
+  E GetEnum(const std::string& key, E def, const std::vector<std::pair<std::string, E>>& names,
+            const std::string& doc) {
+    std::vector<std::string> choices;
+    std::string def_name;
+    for (const auto& [name, value] : names) {
+      choices.push_back(name);
+      if (value == def) def_name = name;
+    }
+    const std::string chosen = GetChoice(key, def_name, choices, doc);
+    for (const auto& [name, value] : names) {
+      if (name == chosen) return value;
+    }
+    return def;
+  }
 
   bool Has(const std::string& key) const;
   // Marks a key as known without reading it (e.g. `type`, which the registry consumed).
