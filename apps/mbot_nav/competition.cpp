@@ -10,6 +10,8 @@
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/common/strings.hpp"
+#include "mbot/drivers/map_io.hpp"
+#include "mbot/drivers/sim_world.hpp"
 #include "stages/report.hpp"
 
 namespace mbot::app {
@@ -20,6 +22,39 @@ std::string Value(const std::vector<std::pair<std::string, std::string>>& kv, co
     if (k == key) return v;
   }
   return "";
+}
+
+std::string PosesText(const std::vector<motion::Pose2D>& poses) {
+  std::string s;
+  for (const motion::Pose2D& p : poses) {
+    char b[96];
+    std::snprintf(b, sizeof b, "%s%.6g, %.6g, %.6g", s.empty() ? "" : "; ", p.x, p.y, p.theta * 180.0 / M_PI);
+    s += b;
+  }
+  return s;
+}
+
+// Another world for an event: the organisers hand the team that world's inputs through the
+// autonomy's own keys — the circuit, the Warehouse's targets and drop-offs, and the known map
+// (written to `dir`) — since the autonomy never reads the simulator's world.
+void HandOutInputs(const std::string& world_path, const std::string& dir, config::Config* event) {
+  const drivers::World world = drivers::World::Load(world_path);
+  const drivers::EventInputs in = drivers::EventInputsOf(world);
+  config::Section mission = event->GetSection("mission");
+  const std::string task = mission.Has("task") ? mission.GetString("task", "", "") : "";
+  if (task == "waypoints" && !in.waypoints.empty()) event->Set("mission.waypoints=" + PosesText(in.waypoints));
+  if (task == "warehouse") {
+    if (!in.targets.empty()) event->Set("mission.targets=" + PosesText(in.targets));
+    if (!in.dropoffs.empty()) event->Set("mission.dropoffs=" + PosesText(in.dropoffs));
+  }
+  config::Section slam = event->GetSection("slam");
+  if (slam.Has("mode") && slam.GetString("mode", "", "") == "localization") {
+    const double resolution = slam.GetDouble("resolution_m", mapping::MapperOptions{}.resolution_m, "", 0.001, 10.0);
+    std::filesystem::create_directories(dir);
+    const std::string map_path = dir + "/known_map.map";
+    drivers::WriteBotlabMap(drivers::RenderKnownMap(world, resolution), map_path);
+    event->Set("slam.map_file=" + map_path);
+  }
 }
 
 struct Row {
@@ -81,7 +116,10 @@ CompetitionPlan BuildCompetition(const config::Config& config) {
       event.Set("pipeline.seed=" + std::to_string(event_seed));
       event.Set("pipeline.progress=off");  // the events are short; the table is the report
       event.Set("output.dir=" + plan.output_dir + "/" + name);
-      if (!world.empty()) event.Set("source.path=" + world);
+      if (!world.empty()) {
+        event.Set("source.path=" + world);
+        HandOutInputs(world, plan.output_dir + "/" + name, &event);
+      }
       for (const std::string& s : sets) event.Set(s);
     } catch (const config::ConfigError& err) {
       e.Fail("set", err.what());

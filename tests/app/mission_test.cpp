@@ -34,14 +34,15 @@ TEST(MissionFollow, DrivesThePathAGuiSendsAndStandsStillBefore) {
   auto max_speed = [&] {
     double v = 0;
     for (const Event& e : bus.events) {
-      if (e.kind == EventKind::kMotorCommand) v = std::max(v, std::get<drivers::MotorCommand>(e.payload).a);
+      if (e.kind == EventKind::kMotorCommand) v = std::max(v, std::get<drivers::MotorCommand>(e.payload).velocity.v_m_s);
     }
     return v;
   };
   odometry(0.5);
   EXPECT_EQ(max_speed(), 0.0);
   bool waiting = false;
-  for (const Event& e : bus.events) waiting = waiting || (e.kind == EventKind::kStatus && std::get<drivers::Status>(e.payload).state == "waiting");
+  for (const Event& e : bus.events) waiting = waiting || (e.kind == EventKind::kMissionStatus &&
+                                                  std::get<mission::MissionStatus>(e.payload).state == mission::MissionState::kWaiting);
   EXPECT_TRUE(waiting);
   bus.events.clear();
   mission->OnEvent(Event{t, t, "CONTROLLER_PATH", EventKind::kPath, drivers::Path{{{1.0, 0.0, 0.0}}}});

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 
 namespace mbot::app {
 namespace {
@@ -45,13 +47,23 @@ TEST(PipelineTest, StrictErrors) {
             std::string::npos);
 }
 
-// Every shipped configuration parses strictly (keys, sections, stage types, values).
+// Every shipped configuration parses strictly (keys, sections, stage types, values). A fragment
+// (no [pipeline] and no [competition]: defaults.ini, warehouse_day.ini) is checked through the
+// configs that include it, and must be included by one.
 TEST(PipelineTest, EveryShippedConfigIsValid) {
   int n = 0;
+  std::string all_text;
+  std::vector<std::string> fragments;
   for (const auto& entry : std::filesystem::directory_iterator(std::string(MBOT_SOURCE_DIR) + "/config")) {
-    if (entry.path().extension() != ".ini" || entry.path().filename() == "defaults.ini") continue;
+    if (entry.path().extension() != ".ini") continue;
     SCOPED_TRACE(entry.path().string());
+    std::ifstream in(entry.path());
+    all_text += std::string(std::istreambuf_iterator<char>(in), {});
     const config::Config c = config::Config::Load(entry.path().string());
+    if (entry.path().filename() == "defaults.ini" || (!c.HasSection("pipeline") && !IsCompetition(c))) {
+      fragments.push_back(entry.path().filename().string());
+      continue;
+    }
     if (IsCompetition(c)) {
       EXPECT_NO_THROW(BuildCompetition(c));
     } else {
@@ -60,6 +72,9 @@ TEST(PipelineTest, EveryShippedConfigIsValid) {
     ++n;
   }
   EXPECT_GE(n, 3);
+  for (const std::string& f : fragments) {
+    EXPECT_NE(all_text.find("include = " + f), std::string::npos) << f << " is a fragment no shipped config includes";
+  }
 }
 
 }  // namespace

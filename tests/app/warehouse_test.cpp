@@ -1,5 +1,6 @@
-// The Warehouse rules the mission and the referee share (apps/mbot_nav/stages/warehouse.hpp).
-#include "stages/warehouse.hpp"
+// The Warehouse rules the mission and the referee share (libs/mission/warehouse_rules.hpp), and the
+// referee's judgement of the stops.
+#include "mbot/mission/warehouse_rules.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,25 +10,34 @@
 #include <sstream>
 
 #include "mbot/common/config.hpp"
+#include "mbot/drivers/map_io.hpp"
+#include "mbot/drivers/sim_world.hpp"
+#include "mbot/mission/mission_config.hpp"
 #include "stage.hpp"
 
 namespace mbot::app {
 namespace {
 
+namespace warehouse = mission::warehouse;
+
 drivers::World Warehouse() { return drivers::World::Load(std::string(MBOT_SOURCE_DIR) + "/datasets/arenas/warehouse.arena"); }
+
+std::vector<warehouse::Stop> StopsOf(const drivers::World& w, uint64_t seed) {
+  return warehouse::Stops(w.PosesLabelled("target"), w.PosesLabelled("dropoff"), seed);
+}
 
 TEST(WarehouseRules, SevenDeliveriesToDistinctTargetsEachOnToADropOff) {
   const drivers::World w = Warehouse();
-  const std::vector<warehouse::Stop> stops = warehouse::Stops(w, 1);
+  const std::vector<warehouse::Stop> stops = StopsOf(w, 1);
   ASSERT_EQ(warehouse::TotalDeliveries(), 7);
   ASSERT_EQ(stops.size(), 14u);
   std::set<int> targets;
   for (size_t k = 0; k < stops.size(); ++k) {
     EXPECT_EQ(stops[k].pickup, k % 2 == 0);
     EXPECT_EQ(stops[k].delivery, static_cast<int>(k / 2));
-    if (stops[k].pickup) targets.insert(stops[k].arena_index);
+    if (stops[k].pickup) targets.insert(stops[k].index);
     const auto& arena = w.PosesLabelled(stops[k].pickup ? "target" : "dropoff");
-    EXPECT_EQ(stops[k].pose.x, arena.at(stops[k].arena_index).x);
+    EXPECT_EQ(stops[k].pose.x, arena.at(stops[k].index).x);
   }
   EXPECT_EQ(targets.size(), 7u);
   EXPECT_EQ(stops[1].Name(), "drop-off 1 (delivery 1)");
@@ -37,7 +47,7 @@ TEST(WarehouseRules, TheSeedDecidesTheOrder) {
   const drivers::World w = Warehouse();
   auto order = [&](uint64_t seed) {
     std::vector<int> o;
-    for (const auto& s : warehouse::Stops(w, seed)) o.push_back(s.arena_index);
+    for (const auto& s : StopsOf(w, seed)) o.push_back(s.index);
     return o;
   };
   EXPECT_EQ(order(3), order(3));
@@ -47,10 +57,10 @@ TEST(WarehouseRules, TheSeedDecidesTheOrder) {
 TEST(WarehouseRules, AnArenaWithoutEnoughTargetsIsNamed) {
   const drivers::World w = drivers::World::ParseArena("name tiny\nbox 0 0 2 2\npose target 1 1 0\npose dropoff 0.5 0.5 0\n", "tiny.arena");
   try {
-    warehouse::Stops(w, 1);
+    StopsOf(w, 1);
     ADD_FAILURE();
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("'tiny' needs 7 'pose target' lines"), std::string::npos) << e.what();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("needs 7 targets and at least one drop-off (has 1 and 1)"), std::string::npos) << e.what();
   }
 }
 
@@ -92,7 +102,7 @@ class RefereeHarness {
 };
 
 TEST(WarehouseReferee, AMissedStopFailsItsDeliveryAndTheNextStillCounts) {
-  const auto stops = warehouse::Stops(Warehouse(), 5);
+  const auto stops = StopsOf(Warehouse(), 5);
   RefereeHarness h("warehouse_referee_missed");
   h.Stand(stops[0].pose, 2.2);                                  // target of delivery 1: done
   h.Stand({stops[1].pose.x + 0.3, stops[1].pose.y, 0}, 1.0);    // near its drop-off, but not at it
@@ -116,7 +126,7 @@ TEST(WarehouseReferee, AMissedStopFailsItsDeliveryAndTheNextStillCounts) {
 // The drop-offs repeat (stop 5 is drop-off 1 again): standing on at drop-off 1 after delivering to
 // it does not count as the later visit, and does not mark the stops between missed.
 TEST(WarehouseReferee, StayingAtADropOffDoesNotCountItsNextVisit) {
-  const auto stops = warehouse::Stops(Warehouse(), 5);
+  const auto stops = StopsOf(Warehouse(), 5);
   ASSERT_EQ(stops[5].pose.x, stops[1].pose.x);
   RefereeHarness h("warehouse_referee_stay");
   h.Stand(stops[0].pose, 2.2);
@@ -128,6 +138,48 @@ TEST(WarehouseReferee, StayingAtADropOffDoesNotCountItsNextVisit) {
   for (int k = 3; k <= 6; ++k) {
     EXPECT_NE(lines[k].find("\"done_at_s\": null, \"missed\": false"), std::string::npos) << lines[k];
   }
+}
+
+}  // namespace
+}  // namespace mbot::app
+
+namespace mbot::app {
+namespace {
+
+// The autonomy's inputs are its own keys (config/warehouse_day.ini, speed_run.ini): they must be
+// what the shipped arenas hold, as the competition runner would hand them out.
+TEST(DayInputs, TheShippedKeysAreTheShippedArenas) {
+  const std::string dir = std::string(MBOT_SOURCE_DIR);
+  auto mission_of = [&](const std::string& ini) {
+    const config::Config c = config::Config::Load(dir + "/config/" + ini);
+    config::Section s = c.GetSection("mission");
+    return mission::ParseMissionOptions(s);
+  };
+  auto expect_same = [](const std::vector<motion::Pose2D>& a, const std::vector<motion::Pose2D>& b, const char* what) {
+    ASSERT_EQ(a.size(), b.size()) << what;
+    for (size_t i = 0; i < a.size(); ++i) {
+      EXPECT_NEAR(a[i].x, b[i].x, 1e-9) << what << " " << i;
+      EXPECT_NEAR(a[i].y, b[i].y, 1e-9) << what << " " << i;
+      EXPECT_NEAR(motion::WrapAngle(a[i].theta - b[i].theta), 0.0, 1e-9) << what << " " << i;
+    }
+  };
+  const drivers::World warehouse = Warehouse();
+  const drivers::EventInputs day = drivers::EventInputsOf(warehouse);
+  const mission::MissionOptions w = mission_of("warehouse.ini");
+  expect_same(w.targets, day.targets, "targets");
+  expect_same(w.dropoffs, day.dropoffs, "drop-offs");
+  const mission::MissionOptions s = mission_of("speed_run.ini");
+  expect_same(s.waypoints, drivers::EventInputsOf(drivers::World::Load(dir + "/datasets/arenas/convex_circuit.arena")).waypoints,
+              "waypoints");
+  // The given map is the arena drawn at the SLAM resolution.
+  std::string format;
+  const mapping::OccupancyGrid shipped = drivers::ReadAnyMap(dir + "/datasets/arenas/warehouse.map", &format);
+  const mapping::OccupancyGrid rendered = drivers::RenderKnownMap(warehouse, 0.05);
+  ASSERT_EQ(shipped.width(), rendered.width());
+  ASSERT_EQ(shipped.height(), rendered.height());
+  EXPECT_NEAR(shipped.origin_x(), rendered.origin_x(), 1e-9);
+  EXPECT_NEAR(shipped.origin_y(), rendered.origin_y(), 1e-9);
+  EXPECT_EQ(shipped.cells(), rendered.cells());
 }
 
 }  // namespace

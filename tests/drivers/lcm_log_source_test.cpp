@@ -78,7 +78,7 @@ TEST(LcmLogSourceTest, DecodesEachRoleByTypeAndChannel) {
   EXPECT_EQ(std::get<EncoderTicks>(ev[4].payload).right_ticks, -20);
   EXPECT_EQ(std::get<EncoderTicks>(ev[4].payload).delta_time_us, 20000);
   EXPECT_EQ(ev[5].kind, EventKind::kMotorCommand);
-  EXPECT_NEAR(std::get<MotorCommand>(ev[5].payload).a, 0.3, 1e-6);
+  EXPECT_NEAR(std::get<MotorCommand>(ev[5].payload).velocity.v_m_s, 0.3, 1e-6);
 }
 
 TEST(LcmLogSourceTest, CountThatDisagreesWithPayloadIsRejected) {

@@ -117,9 +117,9 @@ TEST(SimRobot, EncoderTicksFollowTheWheelRotation) {
     EXPECT_EQ(e.left_ticks, left);
     EXPECT_EQ(e.right_ticks, right);
     EXPECT_EQ(e.delta_time_us, 20000);
-    const auto& s = std::get<MotorCommand>(speeds[i].payload);
-    EXPECT_DOUBLE_EQ(s.a, e.left_delta * rad_per_tick / 0.02);
-    EXPECT_DOUBLE_EQ(s.b, e.right_delta * rad_per_tick / 0.02);
+    const auto& s = std::get<WheelSpeeds>(speeds[i].payload);
+    EXPECT_DOUBLE_EQ(s.left_rad_s, e.left_delta * rad_per_tick / 0.02);
+    EXPECT_DOUBLE_EQ(s.right_rad_s, e.right_delta * rad_per_tick / 0.02);
   }
   // Distance and turn from the ticks match the truth (within a tick or two of quantisation).
   const double m_per_tick = rad_per_tick * o.geometry.wheel_radius_m;
@@ -133,7 +133,7 @@ TEST(SimRobot, EncoderTicksFollowTheWheelRotation) {
   SimRobot mirrored(world, o, {-1.5, 0, 0}, 3);
   const auto straight = Drive(mirrored, 0.2, 0.0, 2.0);
   EXPECT_LT(std::get<EncoderTicks>(OfKind(straight, EventKind::kEncoders).back().payload).right_ticks, -1000);
-  EXPECT_GT(std::get<MotorCommand>(OfKind(straight, EventKind::kWheelSpeed).back().payload).b, 4.0);
+  EXPECT_GT(std::get<WheelSpeeds>(OfKind(straight, EventKind::kWheelSpeed).back().payload).right_rad_s, 4.0);
   const Pose2D odo = PoseOf(OfKind(straight, EventKind::kOdometry).back());
   EXPECT_NEAR(odo.x, mirrored.true_pose().x + 1.5, 0.01);
   EXPECT_NEAR(odo.y, mirrored.true_pose().y, 0.01);
@@ -248,7 +248,9 @@ std::string Fingerprint(const Event& e) {
         } else if constexpr (std::is_same_v<T, Imu>) {
           s << p.gyro_rad_s[2] << ' ' << p.angles_rpy_rad[2];
         } else if constexpr (std::is_same_v<T, MotorCommand>) {
-          s << p.a << ' ' << p.b;
+          s << p.velocity.v_m_s << ' ' << p.velocity.w_rad_s << ' ' << p.left_duty << ' ' << p.right_duty;
+        } else if constexpr (std::is_same_v<T, WheelSpeeds>) {
+          s << p.left_rad_s << ' ' << p.right_rad_s;
         }
       },
       e.payload);
@@ -344,9 +346,9 @@ TEST(SimSource, VelocityCommandsDriveTheRobot) {
   ASSERT_TRUE(until(0.5));
   EXPECT_EQ(sim.robot().distance_travelled_m(), 0.0);
   sink.Send(Event{500000, 500000, "MBOT_VEL_CMD", EventKind::kMotorCommand,
-                  MotorCommand{MotorCommand::Kind::kVelocity, 0.2, 0.0}});
+                  MotorCommand::Velocity(0.2, 0.0)});
   sink.Send(Event{500000, 500000, "MBOT_MOTOR_PWM", EventKind::kMotorCommand,
-                  MotorCommand{MotorCommand::Kind::kPwm, 0.0, 0.0}});  // ignored
+                  MotorCommand::Pwm(0.0, 0.0)});  // ignored
   sink.Send(Event{500000, 500000, "TRUE_POSE", EventKind::kGroundTruth, Pose2D{}});  // ignored
   ASSERT_TRUE(until(2.5));
   EXPECT_GT(sim.robot().true_pose().x, -0.5 + 0.3);
@@ -423,7 +425,7 @@ TEST(SimSource, SpeedOnAMazeArena) {
       blocked = blocked || sim.world().Raycast(p.x, p.y, p.theta + a, 1.0) < 0.3;
     }
     sim.Send(Event{e->t_us, e->t_us, "MBOT_VEL_CMD", EventKind::kMotorCommand,
-                   MotorCommand{MotorCommand::Kind::kVelocity, blocked ? 0.0 : 0.3, blocked ? 1.5 : 0.0}});
+                   MotorCommand::Velocity(blocked ? 0.0 : 0.3, blocked ? 1.5 : 0.0)});
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double speed = o.sim.duration_s / wall;

@@ -99,16 +99,16 @@ TEST(LcmLive, ASilentSensorStopsTheRobotAndHoldsCommandsBack) {
   ASSERT_FALSE(cmds.empty());
   for (const Event& c : cmds) {
     const auto& m = std::get<MotorCommand>(c.payload);
-    EXPECT_EQ(m.a, 0.0);
-    EXPECT_EQ(m.b, 0.0);
+    EXPECT_EQ(m.velocity.v_m_s, 0.0);
+    EXPECT_EQ(m.velocity.w_rad_s, 0.0);
   }
   EXPECT_LE(cmds.size(), 5u) << "zero velocity at 10 Hz, not on every loop";
   // A command from the stack while the sensors are silent goes out as zero.
-  sink->Send(Event{0, 0, "MBOT_VEL_CMD", EventKind::kMotorCommand, MotorCommand{MotorCommand::Kind::kVelocity, 0.3, 0.5}});
+  sink->Send(Event{0, 0, "MBOT_VEL_CMD", EventKind::kMotorCommand, MotorCommand::Velocity(0.3, 0.5)});
   cmds.clear();
   robot.Poll(100, &cmds);
   ASSERT_FALSE(cmds.empty());
-  EXPECT_EQ(std::get<MotorCommand>(cmds.back().payload).a, 0.0);
+  EXPECT_EQ(std::get<MotorCommand>(cmds.back().payload).velocity.v_m_s, 0.0);
   bool held = false;
   for (const auto& [k, v] : source->Details()) held = held || (k == "commands held back" && v == "1");
   EXPECT_TRUE(held);
@@ -119,7 +119,7 @@ TEST(LcmLive, ASilentSensorStopsTheRobotAndHoldsCommandsBack) {
   robot.Publish(Event{0, 5, "LIDAR", EventKind::kLidar, scan});
   robot.Publish(Event{0, 5, "MBOT_ODOMETRY", EventKind::kOdometry, motion::Pose2D{}});
   Drain(*source, 0.2);
-  sink->Send(Event{0, 0, "MBOT_VEL_CMD", EventKind::kMotorCommand, MotorCommand{MotorCommand::Kind::kVelocity, 0.3, 0.5}});
+  sink->Send(Event{0, 0, "MBOT_VEL_CMD", EventKind::kMotorCommand, MotorCommand::Velocity(0.3, 0.5)});
   cmds.clear();
   robot.Poll(100, &cmds);
   while (robot.stats().at("MBOT_VEL_CMD").received < 1000) {  // take everything that came
@@ -129,7 +129,7 @@ TEST(LcmLive, ASilentSensorStopsTheRobotAndHoldsCommandsBack) {
     cmds.insert(cmds.end(), more.begin(), more.end());
   }
   ASSERT_FALSE(cmds.empty());
-  EXPECT_FLOAT_EQ(std::get<MotorCommand>(cmds.back().payload).a, 0.3f);
+  EXPECT_FLOAT_EQ(std::get<MotorCommand>(cmds.back().payload).velocity.v_m_s, 0.3f);
 }
 
 // Called by explore_over_lcm.sh with the live run's map and the map its lcm-logger recording

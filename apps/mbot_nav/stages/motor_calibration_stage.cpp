@@ -57,15 +57,15 @@ class MotorCalibrationStage : public Stage {
     } else if (ev.kind == EventKind::kMotorCommand) {
       const auto& c = std::get<drivers::MotorCommand>(ev.payload);
       if (c.kind != drivers::MotorCommand::Kind::kPwm) return;
-      const double d[2] = {c.a, c.b};
+      const double d[2] = {c.left_duty, c.right_duty};
       for (int w = 0; w < 2; ++w) {
         if (!duty_known_[w] || std::abs(d[w] - duty_[w]) > o_.duty_tolerance) duty_since_[w] = t;
         duty_[w] = d[w];
         duty_known_[w] = true;
       }
     } else if (ev.kind == EventKind::kWheelSpeed) {
-      const auto& c = std::get<drivers::MotorCommand>(ev.payload);
-      AddLogSample(t, c.a, c.b, measured_);
+      const auto& w = std::get<drivers::WheelSpeeds>(ev.payload);
+      AddLogSample(t, w.left_rad_s, w.right_rad_s, measured_);
     } else if (ev.kind == EventKind::kEncoders) {
       const auto& e = std::get<drivers::EncoderTicks>(ev.payload);
       if (have_ticks_) {

@@ -19,10 +19,12 @@
 #include "mbot/drivers/sim_world.hpp"
 #include "report.hpp"
 #include "stages.hpp"
-#include "warehouse.hpp"
+#include "mbot/mission/warehouse_rules.hpp"
 
 namespace mbot::app {
 namespace {
+
+namespace warehouse = mission::warehouse;
 
 using drivers::EventKind;
 using motion::Pose2D;
@@ -33,7 +35,6 @@ struct RefereeOptions {
   double time_limit_s = 180.0;
   double finish_delay_s = 0.5;      // keep simulating this long after completion (the robot stops)
   std::string mission_status_channel = "MISSION_STATUS";
-  std::string slam_status_channel = "SLAM_STATUS";
 };
 
 const char* EventTitle(const std::string& event) {
@@ -73,7 +74,13 @@ class RefereeStage : public Stage {
   void Start(const RunContext& ctx) override {
     bus_ = ctx.bus;
     world_ = drivers::World::Load(ctx.source_path);
-    if (o_.event == "warehouse") stops_ = warehouse::Stops(world_, ctx.seed);
+    if (o_.event == "warehouse") {
+      try {
+        stops_ = warehouse::Stops(world_.PosesLabelled("target"), world_.PosesLabelled("dropoff"), ctx.seed);
+      } catch (const std::invalid_argument& e) {
+        throw std::runtime_error("referee: the world " + ctx.source_path + " has no Warehouse ('pose target' and 'pose dropoff' lines): " + e.what());
+      }
+    }
     wall0_ = std::chrono::steady_clock::now();
   }
 
@@ -97,14 +104,16 @@ class RefereeStage : public Stage {
       case EventKind::kPath:
         path_ = std::get<drivers::Path>(ev.payload).poses;
         break;
-      case EventKind::kStatus: {
-        const auto& s = std::get<drivers::Status>(ev.payload);
-        if (ev.channel == o_.slam_status_channel) {
-          if (s.state == "localized" && localized_us_ < 0) localized_us_ = ev.t_us;
-        } else if (ev.channel == o_.mission_status_channel) {
-          state_ = s.state, detail_ = s.detail;
-          if ((s.state == "completed" || s.state == "failed") && end_us_ < 0) end_us_ = ev.t_us;
+      case EventKind::kSlamStatus:
+        if (std::get<mapping::SlamStatus>(ev.payload).state == mapping::SlamState::kLocalized && localized_us_ < 0) {
+          localized_us_ = ev.t_us;
         }
+        break;
+      case EventKind::kMissionStatus: {
+        if (ev.channel != o_.mission_status_channel) break;
+        const auto& s = std::get<mission::MissionStatus>(ev.payload);
+        state_ = s.state, detail_ = s.detail;
+        if (mission::IsFinal(s.state) && end_us_ < 0) end_us_ = ev.t_us;
         break;
       }
       default:
@@ -113,7 +122,7 @@ class RefereeStage : public Stage {
     if (!bus_ || stop_sent_) return;
     if (end_us_ >= 0 && (ev.t_us - end_us_) * 1e-6 >= o_.finish_delay_s) {
       stop_sent_ = true;
-      bus_->RequestStop("referee: the mission " + state_);
+      bus_->RequestStop(std::string("referee: the mission ") + mission::ToString(state_));
     } else if ((ev.t_us - t0_us_) * 1e-6 >= o_.time_limit_s) {
       stop_sent_ = true;
       timed_out_ = true;
@@ -133,7 +142,7 @@ class RefereeStage : public Stage {
     // Where the map frame lies in the world: SLAM began at the origin at the start pose, or the map
     // was given in the world frame (the Warehouse).
     const Pose2D frame = warehouse ? Pose2D{} : start;
-    const bool completed = state_ == "completed";
+    const bool completed = state_ == mission::MissionState::kCompleted;
     const double time_s = end_us_ >= 0 ? (end_us_ - t0_us_) * 1e-6 : sim_s;
     const double rtf = wall_s > 0 ? sim_s / wall_s : 0.0;
     // Final pose against the start (the robot had to come back), and SLAM's own error at its last pose.
@@ -202,7 +211,7 @@ class RefereeStage : public Stage {
     for (const Item& i : items) total += i.points, max_total += i.max;
 
     std::ostringstream t;
-    const std::string result = timed_out_ ? "time limit" : state_;
+    const std::string result = timed_out_ ? "time limit" : mission::ToString(state_);
     t << "\n" << EventTitle(o_.event) << " - arena " << world_.name() << ", seed " << ctx.seed << ": " << result << " after "
       << Num(time_s, 4) << " s (" << Num(rtf, 3) << "x real time), " << collisions_ << " collisions\n";
     for (const Item& i : items) {
@@ -215,7 +224,7 @@ class RefereeStage : public Stage {
     std::ostringstream j;
     j << "{\n  \"event\": " << JsonString(o_.event) << ",\n  \"world\": " << JsonString(ctx.source_path)
       << ",\n  \"arena\": " << JsonString(world_.name()) << ",\n  \"seed\": " << ctx.seed
-      << ",\n  \"state\": " << JsonString(state_) << ",\n  \"detail\": " << JsonString(detail_)
+      << ",\n  \"state\": " << JsonString(mission::ToString(state_)) << ",\n  \"detail\": " << JsonString(detail_)
       << ",\n  \"completed\": " << (completed ? "true" : "false") << ",\n  \"timed_out\": " << (timed_out_ ? "true" : "false")
       << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"time_s\": " << Num(time_s)
       << ",\n  \"sim_seconds\": " << Num(sim_s) << ",\n  \"wall_seconds\": " << Num(wall_s) << ",\n  \"real_time_factor\": " << Num(rtf)
@@ -342,8 +351,7 @@ class RefereeStage : public Stage {
   // dwell time. Stops are judged in order; standing at a later stop first marks the ones before it
   // missed (that delivery fails, the rest still count).
   static bool Near(const Pose2D& p, const Pose2D& goal) {
-    return std::hypot(p.x - goal.x, p.y - goal.y) <= warehouse::kToleranceM &&
-           std::abs(motion::WrapAngle(p.theta - goal.theta)) * 180.0 / M_PI <= warehouse::kToleranceDeg;
+    return warehouse::AtStop(p, goal);
   }
 
   void JudgeStop(const TimedPose& truth) {
@@ -378,7 +386,8 @@ class RefereeStage : public Stage {
   std::vector<TimedPose> truth_, slam_;
   std::shared_ptr<const mapping::OccupancyGrid> map_;
   std::vector<Pose2D> path_;
-  std::string state_ = "initializing", detail_;
+  mission::MissionState state_ = mission::MissionState::kInitializing;
+  std::string detail_;
   int collisions_ = 0;
   bool stop_sent_ = false, timed_out_ = false;
   int64_t localized_us_ = -1;
@@ -402,7 +411,6 @@ StageType RefereeStageType() {
             o.time_limit_s = s.GetDouble("time_limit_s", o.time_limit_s, "the run ends here if the mission has not [s]", 1.0, 1e5);
             o.finish_delay_s = s.GetDouble("finish_delay_s", o.finish_delay_s, "simulate this long after the mission ends [s]", 0.0, 60.0);
             o.mission_status_channel = s.GetString("mission_status_channel", o.mission_status_channel, "channel of the mission's states");
-            o.slam_status_channel = s.GetString("slam_status_channel", o.slam_status_channel, "channel of SLAM's states");
             return std::make_unique<RefereeStage>(o);
           }};
 }

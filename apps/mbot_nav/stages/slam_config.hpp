@@ -18,7 +18,6 @@ struct SlamStageOptions {
   mapping::SlamOptions slam;
   mapping::ScanOptions scan;
   std::string map_file;                 // localization: the known map
-  bool map_from_world = false;          // localization: the known map is the source's world file
   // Inputs.
   std::string lidar_channel, odometry_channel, ground_truth_channel, reference_channel;  // "" = first seen
   bool encoder_odometry = false;        // odometry from encoder ticks instead of an odometry channel

@@ -17,7 +17,6 @@
 #include "mbot/common/log.hpp"
 #include "mbot/common/strings.hpp"
 #include "mbot/drivers/map_io.hpp"
-#include "mbot/drivers/sim_world.hpp"
 #include "mbot/mapping/slam.hpp"
 #include "mbot/motion/trajectory_error.hpp"
 #include "mbot/motion/wheel_odometry.hpp"
@@ -51,13 +50,9 @@ class SlamStage : public Stage {
     bus_ = ctx.bus;
     slam_ = mapping::Slam(options_.slam, ctx.seed);
     noise_rng_.seed(ctx.seed ^ 0x6f646f6dULL);
-    if (options_.map_from_world) options_.map_file = ctx.source_path;
     if (!options_.map_file.empty()) {
-      std::string format = "arena walls drawn at " + Num(options_.slam.mapper.resolution_m, 3) + " m";
-      // An arena file is a competition's given map (the Warehouse): its walls drawn at the map's resolution.
-      slam_.SetMap(mbot::EndsWith(options_.map_file, ".arena")
-                       ? drivers::RenderKnownMap(drivers::World::Load(options_.map_file), options_.slam.mapper.resolution_m)
-                       : drivers::ReadAnyMap(options_.map_file, &format));
+      std::string format;
+      slam_.SetMap(drivers::ReadAnyMap(options_.map_file, &format));
       mbot::log::Info("slam: known map " + options_.map_file + " (" + format + ", " +
                       std::to_string(slam_.map().width()) + "x" + std::to_string(slam_.map().height()) + ")");
     }
@@ -266,21 +261,20 @@ class SlamStage : public Stage {
   void Publish(const ScanRecord& r) {
     if (!bus_) return;
     bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_POSE", EventKind::kPoseEstimate, r.slam});
-    const bool mapping = options_.slam.mode != mapping::SlamMode::kLocalization;
+    const bool builds_map = options_.slam.mode != mapping::SlamMode::kLocalization;
     // What the pose is worth, on change: a global search that has not settled gives no usable pose.
-    const std::string status = mapping ? "mapping" : !r.status.converged ? "localizing" : r.status.lost ? "lost" : "localized";
-    if (status != published_status_) {
-      published_status_ = status;
-      bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_STATUS", EventKind::kStatus,
-                                      drivers::Status{status, std::string("mode ") + mapping::ToString(options_.slam.mode) +
-                                                                  ", spread " + Num(r.status.spread_m, 3) + " m"}});
+    const mapping::SlamState state = mapping::StateOf(options_.slam.mode, r.status);
+    if (state != published_state_) {
+      published_state_ = state;
+      bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_STATUS", EventKind::kSlamStatus,
+                                      mapping::SlamStatus{state, options_.slam.mode, r.status.spread_m}});
     }
     if (options_.publish_particles_every > 0 && records_.size() % options_.publish_particles_every == 0) {
       drivers::Particles p;
       for (const mapping::Particle& q : slam_.filter().particles()) p.poses.push_back(q.pose), p.weights.push_back(q.weight);
       bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_PARTICLES", EventKind::kParticles, std::move(p)});
     }
-    if (options_.publish_map_every > 0 && (records_.size() == 1 || (mapping && records_.size() % options_.publish_map_every == 0))) {
+    if (options_.publish_map_every > 0 && (records_.size() == 1 || (builds_map && records_.size() % options_.publish_map_every == 0))) {
       bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_MAP", EventKind::kMap,
                                       std::make_shared<const mapping::OccupancyGrid>(slam_.map())});
     }
@@ -499,7 +493,7 @@ class SlamStage : public Stage {
   int64_t previous_scan_us_ = -1;
   int64_t first_t_us_ = -1, last_t_us_ = -1;
   int64_t kidnap_us_ = -1, global_started_us_ = -1;
-  std::string published_status_;
+  std::optional<mapping::SlamState> published_state_;
   int skipped_scans_ = 0;
   std::vector<ScanRecord> records_;
   static constexpr size_t kMaxKeptScans = 200000;

@@ -88,7 +88,7 @@ void LcmLiveSource::Watchdog(Clock::time_point now) {
   if (halted_ && now - last_zero_ >= Seconds(1.0 / kZeroRateHz)) {
     last_zero_ = now;
     const int64_t t = WallClockUs();
-    node_.Publish(Event{t, t, o_.command_channel, EventKind::kMotorCommand, MotorCommand{MotorCommand::Kind::kVelocity, 0, 0}});
+    node_.Publish(Event{t, t, o_.command_channel, EventKind::kMotorCommand, MotorCommand::Velocity(0, 0)});
   }
 }
 
@@ -97,7 +97,7 @@ void LcmLiveSource::Send(const Event& event) {
   if (out.stamp_us == 0) out.stamp_us = WallClockUs();
   if (event.kind == EventKind::kMotorCommand && event.channel == o_.command_channel && halted_) {
     ++held_commands_;
-    out.payload = MotorCommand{MotorCommand::Kind::kVelocity, 0, 0};
+    out.payload = MotorCommand::Velocity(0, 0);
   }
   node_.Publish(out);
 }

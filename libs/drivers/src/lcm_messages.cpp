@@ -172,7 +172,10 @@ Decoder Other(size_t count_offset = 0, size_t element_bytes = 0, const char* fie
 }
 
 // exploration_status_t's STATE_* and STATUS_* constants by value, as this stack's state names.
-const char* const kExplorationStates[] = {"initializing", "exploring", "returning_home", "completed", "failed"};
+// exploration_status_t's states, in the order of its constants, as the mission's states.
+constexpr mission::MissionState kExplorationStates[] = {mission::MissionState::kInitializing, mission::MissionState::kExploring,
+                                                       mission::MissionState::kReturningHome, mission::MissionState::kCompleted,
+                                                       mission::MissionState::kFailed};
 const char* const kExplorationStatuses[] = {"in progress", "complete", "failed"};
 
 std::map<int64_t, Entry> BuildTable() {
@@ -284,7 +287,7 @@ std::map<int64_t, Entry> BuildTable() {
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->kind = EventKind::kMotorCommand;
         ev->stamp_us = m.utime;
-        ev->payload = MotorCommand{MotorCommand::Kind::kVelocity, m.trans_v, m.angular_v};
+        ev->payload = MotorCommand::Velocity(m.trans_v, m.angular_v);
         return true;
       });
   add(mbot_legacy::mbot_motor_command_t::getHash(), "mbot_motor_command_t", kW23, nullptr);
@@ -294,7 +297,7 @@ std::map<int64_t, Entry> BuildTable() {
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->stamp_us = m.utime;
         ev->kind = In(roles.velocity_command, ch) ? EventKind::kMotorCommand : EventKind::kOther;
-        ev->payload = MotorCommand{MotorCommand::Kind::kVelocity, m.vx, m.wz};
+        ev->payload = MotorCommand::Velocity(m.vx, m.wz);
         return true;
       });
   add(mbot_lcm_msgs::mbot_motor_pwm_t::getHash(), "mbot_motor_pwm_t", kCurrent,
@@ -303,7 +306,7 @@ std::map<int64_t, Entry> BuildTable() {
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->kind = EventKind::kMotorCommand;
         ev->stamp_us = m.utime;
-        ev->payload = MotorCommand{MotorCommand::Kind::kPwm, m.pwm[0], m.pwm[1]};
+        ev->payload = MotorCommand::Pwm(m.pwm[0], m.pwm[1]);
         return true;
       });
   add(mbot_lcm_msgs::mbot_motor_vel_t::getHash(), "mbot_motor_vel_t", kCurrent,
@@ -312,7 +315,7 @@ std::map<int64_t, Entry> BuildTable() {
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->kind = EventKind::kWheelSpeed;  // measured wheel speeds, not a command
         ev->stamp_us = m.utime;
-        ev->payload = MotorCommand{MotorCommand::Kind::kWheelSpeed, m.velocity[0], m.velocity[1]};
+        ev->payload = WheelSpeeds{m.velocity[0], m.velocity[1]};
         return true;
       });
   add(maebot::maebot_motor_command_t::getHash(), "maebot_motor_command_t", kMaebot,
@@ -321,8 +324,8 @@ std::map<int64_t, Entry> BuildTable() {
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->kind = EventKind::kMotorCommand;
         ev->stamp_us = m.utime;
-        ev->payload = MotorCommand{MotorCommand::Kind::kPwm, m.left_motor_enabled ? m.left_motor_speed : 0.0,
-                                   m.right_motor_enabled ? m.right_motor_speed : 0.0};
+        ev->payload = MotorCommand::Pwm(m.left_motor_enabled ? m.left_motor_speed : 0.0,
+                                        m.right_motor_enabled ? m.right_motor_speed : 0.0);
         return true;
       });
   add(mbot_w23::mbot_wheel_ctrl_t::getHash(), "mbot_wheel_ctrl_t", kW23,
@@ -331,7 +334,7 @@ std::map<int64_t, Entry> BuildTable() {
         if (!DecodeExact(d, n, &m, err)) return false;
         ev->kind = EventKind::kMotorCommand;
         ev->stamp_us = m.utime;
-        ev->payload = MotorCommand{MotorCommand::Kind::kPwm, m.left_motor_pwm, m.right_motor_pwm};
+        ev->payload = MotorCommand::Pwm(m.left_motor_pwm, m.right_motor_pwm);
         return true;
       });
   add(mbot_w23::mbot_state_t::getHash(), "mbot_state_t", kW23,
@@ -392,9 +395,9 @@ std::map<int64_t, Entry> BuildTable() {
           *err = "state " + std::to_string(m.state) + " / status " + std::to_string(m.status) + " is not one of the botlab's";
           return false;
         }
-        ev->kind = EventKind::kStatus;
+        ev->kind = EventKind::kMissionStatus;
         ev->stamp_us = m.utime;
-        ev->payload = Status{kExplorationStates[m.state], kExplorationStatuses[m.status]};
+        ev->payload = mission::MissionStatus{kExplorationStates[m.state], kExplorationStatuses[m.status]};
         return true;
       });
   add(mbot_lcm_msgs::slam_status_t::getHash(), "slam_status_t", kCurrent, Other<mbot_lcm_msgs::slam_status_t>());
@@ -501,25 +504,27 @@ bool Encode(const Event& ev, std::vector<uint8_t>* out) {
       EncodeMessage(m, out);
       return true;
     }
-    case EventKind::kMotorCommand:
-    case EventKind::kWheelSpeed: {
+    case EventKind::kMotorCommand: {
       const auto& c = std::get<MotorCommand>(ev.payload);
       if (c.kind == MotorCommand::Kind::kVelocity) {
         mbot_lcm_msgs::twist2D_t m{};
         m.utime = ev.stamp_us;
-        m.vx = static_cast<float>(c.a), m.wz = static_cast<float>(c.b);
-        EncodeMessage(m, out);
-      } else if (c.kind == MotorCommand::Kind::kPwm) {
-        mbot_lcm_msgs::mbot_motor_pwm_t m{};
-        m.utime = ev.stamp_us;
-        m.pwm[0] = static_cast<float>(c.a), m.pwm[1] = static_cast<float>(c.b);
+        m.vx = static_cast<float>(c.velocity.v_m_s), m.wz = static_cast<float>(c.velocity.w_rad_s);
         EncodeMessage(m, out);
       } else {
-        mbot_lcm_msgs::mbot_motor_vel_t m{};
+        mbot_lcm_msgs::mbot_motor_pwm_t m{};
         m.utime = ev.stamp_us;
-        m.velocity[0] = static_cast<float>(c.a), m.velocity[1] = static_cast<float>(c.b);
+        m.pwm[0] = static_cast<float>(c.left_duty), m.pwm[1] = static_cast<float>(c.right_duty);
         EncodeMessage(m, out);
       }
+      return true;
+    }
+    case EventKind::kWheelSpeed: {
+      const auto& w = std::get<WheelSpeeds>(ev.payload);
+      mbot_lcm_msgs::mbot_motor_vel_t m{};
+      m.utime = ev.stamp_us;
+      m.velocity[0] = static_cast<float>(w.left_rad_s), m.velocity[1] = static_cast<float>(w.right_rad_s);
+      EncodeMessage(m, out);
       return true;
     }
     case EventKind::kMap: {
@@ -560,20 +565,23 @@ bool Encode(const Event& ev, std::vector<uint8_t>* out) {
       EncodeMessage(m, out);
       return true;
     }
-    case EventKind::kStatus: {
-      // The botlab's status messages: a task's state as exploration_status_t's constants, SLAM's as
-      // slam_status_t's mode (its own states — localizing, localized, lost — have no field there).
-      const Status& st = std::get<Status>(ev.payload);
-      if (ev.channel == "SLAM_STATUS") {  // the slam stage's detail names the mode: "mode <name>, ..."
-        mbot_lcm_msgs::slam_status_t m{};
-        m.utime = ev.stamp_us;
-        const auto has = [&](const char* mode) { return st.detail.find(std::string("mode ") + mode) != std::string::npos; };
-        m.slam_mode = has("mapping-only") ? 0 : has("action-only") ? 1 : has("localization") ? 2 : 3;
-        EncodeMessage(m, out);
-        return true;
-      }
-      // Any other task state: the nearest exploration state (a state of its own, e.g. "driving" or
-      // "lifting", is one in progress).
+    case EventKind::kSlamStatus: {
+      // SLAM's status as slam_status_t's mode (its own states — localizing, localized, lost — have
+      // no field there).
+      const auto& st = std::get<mapping::SlamStatus>(ev.payload);
+      mbot_lcm_msgs::slam_status_t m{};
+      m.utime = ev.stamp_us;
+      m.slam_mode = st.mode == mapping::SlamMode::kMappingOnly   ? 0
+                    : st.mode == mapping::SlamMode::kActionOnly   ? 1
+                    : st.mode == mapping::SlamMode::kLocalization ? 2
+                                                                  : 3;
+      EncodeMessage(m, out);
+      return true;
+    }
+    case EventKind::kMissionStatus: {
+      // A task's state as the nearest exploration_status_t state (a state of its own, e.g. driving
+      // or lifting, is one in progress).
+      const auto& st = std::get<mission::MissionStatus>(ev.payload);
       using X = mbot_lcm_msgs::exploration_status_t;
       X m{};
       m.utime = ev.stamp_us;
@@ -581,7 +589,6 @@ bool Encode(const Event& ev, std::vector<uint8_t>* out) {
       for (int8_t k = 0; k < 5; ++k) {
         if (st.state == kExplorationStates[k]) m.state = k;
       }
-      if (st.state == "returning home") m.state = X::STATE_RETURNING_HOME;  // the explorer's own spelling
       m.status = m.state == X::STATE_COMPLETED_EXPLORATION ? X::STATUS_COMPLETE
                  : m.state == X::STATE_FAILED_EXPLORATION  ? X::STATUS_FAILED
                                                            : X::STATUS_IN_PROGRESS;

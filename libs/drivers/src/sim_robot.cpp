@@ -235,13 +235,13 @@ struct SimRobot::Impl {
     const double wl = pl * dl * rad_per_tick / dt, wr = pr * dr * rad_per_tick / dt;
     out->push_back(MakeEvent(now, sim_channel::kEncoders, EventKind::kEncoders, EncoderTicks{tl, tr, dl, dr, fw_us}));
     out->push_back(MakeEvent(now, sim_channel::kMotorVel, EventKind::kWheelSpeed,
-                             MotorCommand{MotorCommand::Kind::kWheelSpeed, wl, wr}));
+                             WheelSpeeds{wl, wr}));
     out->push_back(MakeEvent(now, sim_channel::kOdometry, EventKind::kOdometry, odometry.AddEncoders(now, tl, tr)));
     const motion::WheelDuties duties = controller.Update(cmd_v, cmd_w, wl, wr);
     duty_l = duties.left;
     duty_r = duties.right;
     out->push_back(MakeEvent(now, sim_channel::kMotorPwm, EventKind::kMotorCommand,
-                             MotorCommand{MotorCommand::Kind::kPwm, duty_l, duty_r}));
+                             MotorCommand::Pwm(duty_l, duty_r)));
   }
 
   void AdvanceTo(int64_t t_end, std::vector<Event>* out) {

@@ -92,7 +92,7 @@ std::vector<std::pair<std::string, std::string>> SimSource::Details() const {
 void SimSource::Send(const Event& event) {
   if (event.kind != EventKind::kMotorCommand) return;
   const auto* cmd = std::get_if<MotorCommand>(&event.payload);
-  if (cmd && cmd->kind == MotorCommand::Kind::kVelocity) robot_->Command(cmd->a, cmd->b);
+  if (cmd && cmd->kind == MotorCommand::Kind::kVelocity) robot_->Command(cmd->velocity.v_m_s, cmd->velocity.w_rad_s);
 }
 
 }  // namespace mbot::drivers

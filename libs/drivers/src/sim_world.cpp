@@ -633,6 +633,18 @@ mapping::OccupancyGrid RenderKnownMap(const World& world, double resolution_m) {
   return m;
 }
 
+EventInputs EventInputsOf(const World& world) {
+  EventInputs in;
+  const std::vector<motion::Pose2D> starts = world.PosesLabelled("start");
+  if (!starts.empty()) {
+    const motion::Pose2D inv = starts[0].Inverse();
+    for (const motion::Pose2D& w : world.PosesLabelled("waypoint")) in.waypoints.push_back(inv.Compose(w));
+  }
+  in.targets = world.PosesLabelled("target");
+  in.dropoffs = world.PosesLabelled("dropoff");
+  return in;
+}
+
 motion::Pose2D RandomFreePose(const World& world, double clearance_m, uint64_t seed) {
   const mapping::OccupancyGrid& t = world.truth();
   const std::vector<uint8_t> reach = ReachableFromStart(world);

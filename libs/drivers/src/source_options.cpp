@@ -244,7 +244,8 @@ const char* ToString(EventKind kind) {
     case EventKind::kCollision: return "collision";
     case EventKind::kPoseEstimate: return "pose estimate";
     case EventKind::kPath: return "path";
-    case EventKind::kStatus: return "status";
+    case EventKind::kSlamStatus: return "SLAM status";
+    case EventKind::kMissionStatus: return "mission status";
     case EventKind::kParticles: return "particles";
     case EventKind::kOther: return "other";
   }

@@ -14,6 +14,21 @@ const char* ToString(SlamMode mode) {
   return "?";
 }
 
+const char* ToString(SlamState state) {
+  switch (state) {
+    case SlamState::kMapping: return "mapping";
+    case SlamState::kLocalizing: return "localizing";
+    case SlamState::kLocalized: return "localized";
+    case SlamState::kLost: return "lost";
+  }
+  return "?";
+}
+
+SlamState StateOf(SlamMode mode, const FilterStatus& status) {
+  if (mode != SlamMode::kLocalization) return SlamState::kMapping;
+  return !status.converged ? SlamState::kLocalizing : status.lost ? SlamState::kLost : SlamState::kLocalized;
+}
+
 Slam::Slam(const SlamOptions& options, uint64_t seed)
     : options_(options),
       mapper_(options.mapper),

@@ -9,6 +9,9 @@
 #include <vector>
 
 #include "mbot/mapping/occupancy_grid.hpp"
+#include "mbot/mapping/slam.hpp"
+#include "mbot/mission/mission_state.hpp"
+#include "mbot/motion/motion_controller.hpp"
 #include "mbot/motion/pose2d.hpp"
 
 namespace mbot::drivers {
@@ -38,13 +41,21 @@ struct Imu {
   bool has_angles = false;
 };
 
+// A command to the robot's motors: a body velocity (MBOT_VEL_CMD) or duties for the two motors.
 struct MotorCommand {
-  enum class Kind { kVelocity, kPwm, kWheelSpeed };
+  enum class Kind { kVelocity, kPwm };
   Kind kind = Kind::kVelocity;
-  // kVelocity: a = v [m/s], b = ω [rad/s]; kPwm: a = left, b = right duty in [-1, 1];
-  // kWheelSpeed: a = left, b = right wheel speed [rad/s].
-  double a = 0.0;
-  double b = 0.0;
+  motion::VelocityCommand velocity;  // kVelocity
+  double left_duty = 0.0;            // kPwm: duty in [-1, 1]
+  double right_duty = 0.0;
+  static MotorCommand Velocity(double v_m_s, double w_rad_s) { return {Kind::kVelocity, {v_m_s, w_rad_s}, 0.0, 0.0}; }
+  static MotorCommand Pwm(double left, double right) { return {Kind::kPwm, {}, left, right}; }
+};
+
+// Wheel speeds the robot measured (MBOT_MOTOR_VEL, the encoders' rates) — not a command.
+struct WheelSpeeds {
+  double left_rad_s = 0.0;
+  double right_rad_s = 0.0;
 };
 
 // A planning query from a benchmark file (botlab A* cases, Moving AI scenarios) or, live, from a
@@ -77,12 +88,6 @@ struct Particles {
   std::vector<double> weights;
 };
 
-// What a stage reports about its task (exploration, competition event), botlab-style.
-struct Status {
-  std::string state;   // e.g. "exploring", "returning_home", "completed", "failed"
-  std::string detail;  // free text
-};
-
 enum class EventKind {
   kLidar,          // LidarScan
   kOdometry,       // Pose2D, the robot's own dead-reckoning
@@ -93,12 +98,13 @@ enum class EventKind {
   kReferencePose,  // Pose2D from another estimator (staff SLAM, corrected CARMEN poses)
   kMap,            // shared_ptr<const OccupancyGrid>
   kPlanRequest,    // PlanRequest, on the channel named after its map
-  kWheelSpeed,     // MotorCommand{kWheelSpeed}: wheel speeds measured by the robot (not a command)
+  kWheelSpeed,     // WheelSpeeds measured by the robot (not a command)
   kMotorSample,    // WheelSample from a calibration file
   kCollision,      // Pose2D: the true pose at which the simulated robot touched a wall
   kPoseEstimate,   // Pose2D: the stack's own pose estimate (SLAM / localization output)
   kPath,           // Path: the planned path the controller follows
-  kStatus,         // Status of a task (exploration, competition event)
+  kSlamStatus,     // mapping::SlamStatus: what SLAM's pose is worth (SLAM_STATUS)
+  kMissionStatus,  // mission::MissionStatus: the state of the robot's task (exploration, competition event)
   kParticles,      // Particles: the localization's samples
   kOther,          // recognised but not used by the pipeline (time sync, resets, legacy particles …)
 };
@@ -106,8 +112,8 @@ enum class EventKind {
 const char* ToString(EventKind kind);
 
 using Payload = std::variant<std::monostate, LidarScan, motion::Pose2D, EncoderTicks, Imu,
-                             MotorCommand, std::shared_ptr<const mapping::OccupancyGrid>, PlanRequest, WheelSample,
-                             Path, Status, Particles>;
+                             MotorCommand, WheelSpeeds, std::shared_ptr<const mapping::OccupancyGrid>, PlanRequest,
+                             WheelSample, Path, mapping::SlamStatus, mission::MissionStatus, Particles>;
 
 struct Event {
   int64_t t_us = 0;       // event (reception / log) time; the order of the stream

@@ -99,6 +99,17 @@ std::vector<uint8_t> ReachableFreeMask(const World& world, const motion::Pose2D&
 // The map's frame is the world frame.
 mapping::OccupancyGrid RenderKnownMap(const World& world, double resolution_m);
 
+// What the organisers hand a team for an event in this world, which the autonomy gets through its
+// own configuration keys (it never reads the world): the circuit (the `waypoint` poses in the frame
+// of the `start` pose, where SLAM begins), and the Warehouse's `target` and `dropoff` poses in the
+// world frame (the known map's frame, RenderKnownMap). Empty where the world has none.
+struct EventInputs {
+  std::vector<motion::Pose2D> waypoints;
+  std::vector<motion::Pose2D> targets;
+  std::vector<motion::Pose2D> dropoffs;
+};
+EventInputs EventInputsOf(const World& world);
+
 // A pose drawn uniformly from the free space reachable from the world's `start` pose (any free
 // space when it has none) that keeps `clearance_m` from every wall, heading uniform; the same seed
 // gives the same pose. Throws when 10,000 draws find no such place.

@@ -21,6 +21,19 @@ namespace mbot::mapping {
 enum class SlamMode { kMappingOnly, kActionOnly, kLocalization, kFullSlam };
 const char* ToString(SlamMode mode);
 
+// What SLAM's pose is worth, published as SLAM_STATUS: the mapping modes map; localization has not
+// settled yet (global search), has settled, or has lost the robot.
+enum class SlamState { kMapping, kLocalizing, kLocalized, kLost };
+const char* ToString(SlamState state);  // "mapping", "localizing", "localized", "lost"
+SlamState StateOf(SlamMode mode, const FilterStatus& status);
+
+// SLAM's status: its state, its mode and the particles' spread.
+struct SlamStatus {
+  SlamState state = SlamState::kMapping;
+  SlamMode mode = SlamMode::kFullSlam;
+  double spread_m = 0.0;
+};
+
 struct SlamOptions {
   SlamMode mode = SlamMode::kFullSlam;
   MapperOptions mapper;

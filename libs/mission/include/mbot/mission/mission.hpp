@@ -1,0 +1,141 @@
+// The mission: the robot's autonomy after SLAM. One task — a circuit of waypoints, exploring and
+// returning home, the Warehouse's deliveries in a known map, or driving the paths a GUI sends —
+// decides where to go (A* paths, frontiers); the mission around it turns the pose into velocity
+// commands through the motion controller and owns what every task shares: the pose between SLAM
+// updates (the SLAM pose moved on by odometry), stall recovery (back off, replan), and settling at
+// a goal (wait until the robot stands still, correct the final pose). It never touches a file, a
+// bus or a clock: the caller hands it SLAM's outputs and the odometry with their times, and gets
+// back what to command and publish. Frames: every pose is in the map frame (SLAM's), metres and
+// radians; times are microseconds on the data's clock.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "mbot/mapping/occupancy_grid.hpp"
+#include "mbot/mapping/slam.hpp"
+#include "mbot/mission/mission_state.hpp"
+#include "mbot/motion/motion_controller.hpp"
+#include "mbot/motion/pose2d.hpp"
+#include "mbot/planning/exploration.hpp"
+
+namespace mbot::mission {
+
+enum class TaskKind { kWaypoints, kExplore, kWarehouse, kFollow };
+const char* ToString(TaskKind kind);
+
+struct MissionOptions {
+  TaskKind task = TaskKind::kWaypoints;
+  // waypoints: the circuit, in the map frame (SLAM starts at the origin at the start pose).
+  std::vector<motion::Pose2D> waypoints;
+  // warehouse: the day's targets and drop-offs in the known map's frame; the order of the
+  // deliveries follows from them and the seed (warehouse_rules.hpp).
+  std::vector<motion::Pose2D> targets;
+  std::vector<motion::Pose2D> dropoffs;
+  int deliveries = 0;  // warehouse: make only the first this many of the seed's order (0: all the rules ask)
+  motion::MotionControllerOptions controller;
+  planning::ExplorationOptions exploration;
+  double explore_period_s = 0.25;  // explorer updates at most this often [s]
+  double start_delay_s = 0.5;      // stand still this long after the first SLAM pose (map the start)
+  double max_pose_age_s = 1.0;     // stop when the SLAM pose is older than this [s]
+  // The wheels answer a command late (the firmware filters v, ω and the PWM; the motors lag): the
+  // controller is given the pose predicted this far ahead at the measured velocity.
+  double control_lag_s = 0.2;
+  int max_corrections = 5;      // times the final pose is driven to again after stopping outside the tolerances
+  double stuck_s = 1.0;         // commanded to move but not moving this long: back off
+  double backoff_s = 0.6;       // reversing at 0.1 m/s
+  int max_stalls = 10;          // stalls on the way to one goal before the mission gives up
+  double dwell_s = 2.5;         // warehouse: standing at a stop (lifting, setting down) [s]
+};
+
+// What the mission asks the caller to do, in order: publish a state, publish a path (the
+// controller's plan), or send a velocity command.
+struct PathOut {
+  std::vector<motion::Pose2D> poses;
+};
+using MissionOutput = std::variant<MissionStatus, PathOut, motion::VelocityCommand>;
+
+// Counters for the mission's report.
+struct MissionReport {
+  TaskKind task = TaskKind::kWaypoints;
+  MissionStatus status;
+  long long commands = 0, paths = 0, stale_pose_stops = 0;
+  int corrections = 0, stall_recoveries = 0;
+  // warehouse: stops in all, and done by the mission's own estimate.
+  int stops = 0, stops_done = 0;
+};
+
+class Task;
+
+class Mission {
+ public:
+  // `seed` orders the Warehouse's deliveries. Throws std::invalid_argument when the task's inputs
+  // are missing (no waypoints, too few targets).
+  Mission(const MissionOptions& options, uint64_t seed);
+  ~Mission();
+  Mission(const Mission&) = delete;
+  Mission& operator=(const Mission&) = delete;
+
+  // SLAM's outputs, as they come.
+  void OnPoseEstimate(int64_t t_us, const motion::Pose2D& pose);
+  void OnMap(std::shared_ptr<const mapping::OccupancyGrid> map);
+  void OnSlamState(mapping::SlamState state);
+  // follow: a path sent by a GUI (replaces the one being driven).
+  void OnPath(const std::vector<motion::Pose2D>& path);
+  // The control step, on every odometry message (the firmware's 50 Hz): what to publish and
+  // command now. Every step ends with exactly one velocity command.
+  std::vector<MissionOutput> OnOdometry(int64_t t_us, const motion::Pose2D& odometry);
+
+  const MissionStatus& status() const { return status_; }
+  const MissionOptions& options() const { return o_; }
+  MissionReport Report() const;
+
+  // --- for the tasks (src/tasks.cpp) ---
+  void SetState(MissionState state, const std::string& detail);
+  // A new path for the controller; published unless `publish` is false (a path that came in from
+  // outside is not sent back).
+  void SetPath(const std::vector<motion::Pose2D>& path, bool publish = true);
+  // The path ends at `goal`, where the robot must stop within the final tolerances.
+  void SetGoal(const motion::Pose2D& goal);
+  void Hold();  // command zero velocity this step
+  bool final_leg() const { return final_leg_; }
+  void EndFinalLeg() { final_leg_ = false; }
+  bool backing_off() const { return t_us_ < backoff_until_us_; }
+  int64_t now_us() const { return t_us_; }
+  const std::shared_ptr<const mapping::OccupancyGrid>& map() const { return map_; }
+  std::optional<mapping::SlamState> slam_state() const { return slam_state_; }
+
+ private:
+  bool PoseNow(motion::Pose2D* pose) const;
+  bool Recovering();
+  bool Settled(const motion::Pose2D& pose, std::string* how);
+  motion::VelocityCommand MeasuredVelocity() const;
+  motion::Pose2D Predict(const motion::Pose2D& pose) const;
+  void Send(double v, double w);
+
+  MissionOptions o_;
+  std::unique_ptr<Task> task_;
+  motion::MotionController controller_;
+  std::vector<MissionOutput>* out_ = nullptr;  // during OnOdometry
+  int64_t t_us_ = 0;                          // the step's time
+  motion::TimedPose slam_;
+  bool has_slam_ = false;
+  int64_t first_slam_us_ = -1, last_control_us_ = -1;
+  std::vector<motion::TimedPose> odometry_;  // the last ~5 s
+  std::shared_ptr<const mapping::OccupancyGrid> map_;
+  std::optional<mapping::SlamState> slam_state_;
+  bool final_leg_ = false;  // the path ends at goal_, where the robot must stop within the tolerances
+  motion::Pose2D goal_;
+  motion::Pose2D stall_goal_{1e9, 1e9, 0};  // the goal the stall budget is for
+  MissionStatus status_;
+  long long commands_ = 0, paths_ = 0, stale_stops_ = 0;
+  int corrections_ = 0, total_corrections_ = 0, recoveries_ = 0, stalls_this_goal_ = 0;
+  motion::VelocityCommand last_command_;
+  int64_t stuck_since_us_ = -1, backoff_until_us_ = 0;
+};
+
+}  // namespace mbot::mission

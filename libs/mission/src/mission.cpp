@@ -1,0 +1,220 @@
+#include "mbot/mission/mission.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "mbot/common/log.hpp"
+#include "tasks.hpp"
+
+namespace mbot::mission {
+namespace {
+
+using motion::Pose2D;
+using motion::TimedPose;
+
+// Within this many final tolerances of the goal, a correction only turns on the spot, and after a
+// first correction the position counts as reached.
+constexpr double kTurnOnlyWithin = 1.5;
+
+// Paths ending this close to the previous one's end lead to the same goal (the stall budget carries on).
+constexpr double kSameGoalM = 0.10;
+
+std::string Fixed(double v, int digits) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.*g", digits, v);
+  return b;
+}
+
+}  // namespace
+
+const char* ToString(TaskKind kind) {
+  switch (kind) {
+    case TaskKind::kWaypoints: return "waypoints";
+    case TaskKind::kExplore: return "explore";
+    case TaskKind::kWarehouse: return "warehouse";
+    case TaskKind::kFollow: return "follow";
+  }
+  return "?";
+}
+
+Mission::Mission(const MissionOptions& options, uint64_t seed)
+    : o_(options), task_(MakeTask(o_, seed)), controller_(o_.controller) {}
+
+Mission::~Mission() = default;
+
+void Mission::OnPoseEstimate(int64_t t_us, const Pose2D& pose) {
+  slam_ = {t_us, pose};
+  has_slam_ = true;
+  if (first_slam_us_ < 0) first_slam_us_ = t_us;
+}
+
+void Mission::OnMap(std::shared_ptr<const mapping::OccupancyGrid> map) { map_ = std::move(map); }
+
+void Mission::OnSlamState(mapping::SlamState state) { slam_state_ = state; }
+
+void Mission::OnPath(const std::vector<Pose2D>& path) { task_->PathReceived(path); }
+
+MissionReport Mission::Report() const {
+  MissionReport r;
+  r.task = o_.task;
+  r.status = status_;
+  r.commands = commands_, r.paths = paths_, r.stale_pose_stops = stale_stops_;
+  r.corrections = total_corrections_, r.stall_recoveries = recoveries_;
+  task_->AddToReport(&r);
+  return r;
+}
+
+std::vector<MissionOutput> Mission::OnOdometry(int64_t t_us, const Pose2D& odometry) {
+  std::vector<MissionOutput> out;
+  out_ = &out;
+  t_us_ = t_us;
+  odometry_.push_back({t_us, odometry});
+  if (odometry_.front().t_us < t_us - 10'000'000) {  // trim to 5 s now and then, not every message
+    odometry_.erase(odometry_.begin(), std::lower_bound(odometry_.begin(), odometry_.end(), t_us - 5'000'000,
+                                                        [](const TimedPose& p, int64_t t) { return p.t_us < t; }));
+  }
+  const double dt = last_control_us_ >= 0 ? (t_us - last_control_us_) * 1e-6 : 0.0;
+  last_control_us_ = t_us;
+  Pose2D pose;
+  if (!PoseNow(&pose) || (t_us - first_slam_us_) * 1e-6 < o_.start_delay_s) {
+    SetState(MissionState::kInitializing, "waiting for SLAM");
+    Hold();
+  } else if ((t_us - slam_.t_us) * 1e-6 > o_.max_pose_age_s) {
+    ++stale_stops_;
+    SetState(status_.state, "SLAM pose stale: stopped");
+    Hold();
+  } else if (IsFinal(status_.state) && !task_->Resumes()) {
+    Hold();  // done (follow: until the next path, which a failure does not end)
+  } else if (task_->Step(*this, pose) && !Recovering()) {
+    const motion::VelocityCommand c = controller_.Update(Predict(pose), dt);
+    Send(c.v_m_s, c.w_rad_s);
+    last_command_ = c;
+    std::string how;
+    if (final_leg_ && controller_.arrived() && Settled(pose, &how)) task_->Arrived(*this, how);
+  }
+  out_ = nullptr;
+  return out;
+}
+
+// The pose now: the SLAM pose at its scan, moved on by what odometry says happened since.
+bool Mission::PoseNow(Pose2D* pose) const {
+  if (!has_slam_ || odometry_.empty()) return false;
+  Pose2D odo_then;
+  if (!motion::InterpolateAt(odometry_, slam_.t_us, 200'000, &odo_then)) return false;
+  const Pose2D delta = odo_then.Inverse().Compose(odometry_.back().pose);
+  *pose = slam_.pose.Compose(delta);
+  return true;
+}
+
+// A robot pushing against a wall stalls: its wheels (hence odometry) stop while it is told to
+// drive. After `stuck_s` of that, back off for `backoff_s`, then let the controller (and the task,
+// which replans from the new pose) take over again.
+bool Mission::Recovering() {
+  if (t_us_ < backoff_until_us_) {
+    Send(-0.1, 0.0);
+    return true;
+  }
+  const motion::VelocityCommand v = MeasuredVelocity();
+  const bool pushing = std::abs(last_command_.v_m_s) > 0.05 || std::abs(last_command_.w_rad_s) > 0.3;
+  const bool still = std::abs(v.v_m_s) < 0.01 && std::abs(v.w_rad_s) < 0.05;
+  if (!pushing || !still) {
+    stuck_since_us_ = -1;
+    return false;
+  }
+  if (stuck_since_us_ < 0) stuck_since_us_ = t_us_;
+  if ((t_us_ - stuck_since_us_) * 1e-6 < o_.stuck_s) return false;
+  if (++stalls_this_goal_ > o_.max_stalls) {
+    SetState(MissionState::kFailed, "stalled " + std::to_string(stalls_this_goal_) + " times on the way to one goal");
+    Hold();
+    return true;
+  }
+  ++recoveries_;
+  mbot::log::Warn("mission: stalled for " + Fixed(o_.stuck_s, 3) + " s while commanded to move: backing off");
+  stuck_since_us_ = -1;
+  last_command_ = {};
+  backoff_until_us_ = t_us_ + static_cast<int64_t>(o_.backoff_s * 1e6);
+  task_->Stalled(*this);
+  Send(-0.1, 0.0);
+  return true;
+}
+
+// At the final pose (goal_): the controller has stopped commanding, but the wheels lag, so wait
+// until the robot stands still, then check the pose; outside the tolerances, drive to it again.
+// True once it stands at the goal (or the corrections are spent); *how says how well.
+bool Mission::Settled(const Pose2D& pose, std::string* how) {
+  const motion::VelocityCommand v = MeasuredVelocity();
+  if (std::abs(v.v_m_s) > 0.005 || std::abs(v.w_rad_s) > 0.02) return false;
+  const double d = std::hypot(goal_.x - pose.x, goal_.y - pose.y);
+  const double e = std::abs(motion::WrapAngle(goal_.theta - pose.theta));
+  // A diff-drive robot cannot step sideways: re-driving to a point a centimetre or two off turns
+  // towards it (up to 90 degrees), creeps, and turns back, and can end worse than it began. So
+  // the position tolerance is final_tolerance_m on arrival, and kTurnOnlyWithin times that once a
+  // correction has been made; within it a wrong heading is corrected by turning on the spot.
+  const double tolerance = o_.controller.final_tolerance_m * (corrections_ > 0 ? kTurnOnlyWithin : 1.0);
+  const bool heading_ok = e <= o_.controller.final_heading_tolerance_rad;
+  if ((d <= tolerance && heading_ok) || corrections_ >= o_.max_corrections) {
+    *how = std::to_string(corrections_) + " corrections; off by " + Fixed(d, 3) + " m, " + Fixed(e * 180 / M_PI, 3) +
+           " deg by its own estimate";
+    return true;
+  }
+  ++corrections_, ++total_corrections_;
+  const bool publish = task_->PublishesPaths();
+  if (!heading_ok && d <= kTurnOnlyWithin * o_.controller.final_tolerance_m) {
+    SetPath({Pose2D{pose.x, pose.y, goal_.theta}}, publish);
+  } else {
+    SetPath({goal_}, publish);
+  }
+  return false;
+}
+
+// Body velocity from odometry over the last 0.1 s.
+motion::VelocityCommand Mission::MeasuredVelocity() const {
+  if (odometry_.size() < 2) return {};
+  const TimedPose& now = odometry_.back();
+  size_t i = odometry_.size() - 1;
+  while (i > 0 && now.t_us - odometry_[i].t_us < 100'000) --i;
+  const double dt = (now.t_us - odometry_[i].t_us) * 1e-6;
+  if (dt <= 0) return {};
+  const Pose2D d = odometry_[i].pose.Inverse().Compose(now.pose);
+  return {d.x / dt, d.theta / dt};
+}
+
+// The pose `control_lag_s` ahead at the velocity odometry measured over the last 0.1 s.
+Pose2D Mission::Predict(const Pose2D& pose) const {
+  if (o_.control_lag_s <= 0) return pose;
+  return motion::StepUnicycle(pose, MeasuredVelocity(), o_.control_lag_s);
+}
+
+void Mission::SetState(MissionState state, const std::string& detail) {
+  if (state == status_.state && detail == status_.detail) return;
+  status_ = {state, detail};
+  mbot::log::Info(std::string("mission: ") + ToString(state) + (detail.empty() ? "" : " (" + detail + ")"));
+  if (out_) out_->emplace_back(std::in_place_type<MissionStatus>, status_);
+}
+
+void Mission::SetPath(const std::vector<Pose2D>& path, bool publish) {
+  // A new goal (not a replan or a correction towards the same one) gets a fresh stall budget.
+  if (!path.empty() && std::hypot(path.back().x - stall_goal_.x, path.back().y - stall_goal_.y) > kSameGoalM) {
+    stall_goal_ = path.back();
+    stalls_this_goal_ = 0;
+  }
+  controller_.SetPath(path);
+  ++paths_;
+  if (out_ && publish) out_->emplace_back(std::in_place_type<PathOut>, PathOut{path});
+}
+
+void Mission::SetGoal(const Pose2D& goal) {
+  goal_ = goal;
+  final_leg_ = true;
+  corrections_ = 0;
+}
+
+void Mission::Hold() { Send(0, 0); }
+
+void Mission::Send(double v, double w) {
+  ++commands_;
+  if (out_) out_->emplace_back(std::in_place_type<motion::VelocityCommand>, motion::VelocityCommand{v, w});
+}
+
+}  // namespace mbot::mission
