@@ -4,5 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install_deps.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release ${MBOT_CMAKE_ARGS:-}
+werror=OFF
+if [ "${CI:-}" = "true" ]; then werror=ON; fi  # build warnings are errors in CI
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DMBOT_WERROR=$werror ${MBOT_CMAKE_ARGS:-}
 cmake --build build

@@ -31,6 +31,7 @@ options:
   --print-config         print the effective configuration and exit
   --list-stages          list the stage types with their keys and defaults and exit
   --quiet                print warnings and errors only
+  --version              print the version and exit
   --help                 this text
 
 exit status: 0 done, 1 run-time error, 2 configuration or usage error, 130 interrupted (outputs written)
@@ -74,6 +75,9 @@ int main(int argc, char** argv) {
     };
     if (a == "--help" || a == "-h") {
       std::cout << kUsage;
+      return 0;
+    } else if (a == "--version") {
+      std::cout << "mbot_nav " << MBOT_NAV_VERSION << "\n";
       return 0;
     } else if (a == "--config") {
       config_path = value("--config");
