@@ -70,7 +70,7 @@ TEST(PlanningCasesSourceTest, MovingAiScenariosFlipRowsAndFindTheirMap) {
   ASSERT_TRUE(map);
   const auto& grid = *std::get<std::shared_ptr<const mapping::OccupancyGrid>>(map->payload);
   EXPECT_GT(grid.at(1, 1), 0);  // the '@' row is the middle one either way
-  const auto& r = std::get<PlanRequest>(src.Next()->payload);
+  const PlanRequest r = std::get<PlanRequest>(src.Next()->payload);  // a copy: the event is a temporary
   EXPECT_EQ(r.start.x, 0.5);
   EXPECT_EQ(r.start.y, 2.5);  // Moving AI row 0 is the top: grid row 2
   EXPECT_EQ(r.goal.y, 0.5);

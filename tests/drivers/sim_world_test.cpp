@@ -491,8 +491,12 @@ TEST(SimWorld, RenderKnownMapDrawsTheWallsAndTheReachableFloor) {
     for (int x = 0; x < m.width(); ++x) {
       double wx, wy;
       m.CellToWorld(x, y, &wx, &wy);
-      if (m.at(x, y) > 0) EXPECT_LE(w.ClearanceAt(wx, wy), 0.025 + 1e-9);
-      if (m.at(x, y) < 0) EXPECT_GT(w.ClearanceAt(wx, wy), 0.025);
+      if (m.at(x, y) > 0) {
+        EXPECT_LE(w.ClearanceAt(wx, wy), 0.025 + 1e-9);
+      }
+      if (m.at(x, y) < 0) {
+        EXPECT_GT(w.ClearanceAt(wx, wy), 0.025);
+      }
     }
   }
 }
