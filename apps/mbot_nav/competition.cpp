@@ -11,7 +11,7 @@
 #include "mbot/common/log.hpp"
 #include "mbot/common/strings.hpp"
 #include "mbot/drivers/map_io.hpp"
-#include "mbot/drivers/sim_world.hpp"
+#include "mbot/sim/world.hpp"
 #include "stages/report.hpp"
 
 namespace mbot::app {
@@ -38,8 +38,8 @@ std::string PosesText(const std::vector<motion::Pose2D>& poses) {
 // autonomy's own keys — the circuit, the Warehouse's targets and drop-offs, and the known map
 // (written to `dir`) — since the autonomy never reads the simulator's world.
 void HandOutInputs(const std::string& world_path, const std::string& dir, config::Config* event) {
-  const drivers::World world = drivers::World::Load(world_path);
-  const drivers::EventInputs in = drivers::EventInputsOf(world);
+  const sim::World world = sim::World::Load(world_path);
+  const sim::EventInputs in = sim::EventInputsOf(world);
   config::Section mission = event->GetSection("mission");
   const std::string task = mission.Has("task") ? mission.GetString("task", "", "") : "";
   if (task == "waypoints" && !in.waypoints.empty()) event->Set("mission.waypoints=" + PosesText(in.waypoints));
@@ -52,7 +52,7 @@ void HandOutInputs(const std::string& world_path, const std::string& dir, config
     const double resolution = slam.GetDouble("resolution_m", mapping::MapperOptions{}.resolution_m, "", 0.001, 10.0);
     std::filesystem::create_directories(dir);
     const std::string map_path = dir + "/known_map.map";
-    drivers::WriteBotlabMap(drivers::RenderKnownMap(world, resolution), map_path);
+    drivers::WriteBotlabMap(sim::RenderKnownMap(world, resolution), map_path);
     event->Set("slam.map_file=" + map_path);
   }
 }

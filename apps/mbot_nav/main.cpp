@@ -30,6 +30,7 @@ options:
   --set S.K=V            override key K of section S (repeatable; applied after includes)
   --print-config         print the effective configuration and exit
   --list-stages          list the stage types with their keys and defaults and exit
+  --list-sources         list the source types ([source] type) and what each reads, and exit
   --quiet                print warnings and errors only
   --version              print the version and exit
   --help                 this text
@@ -47,15 +48,22 @@ void ListStages() {
     std::cout << "\n";
   };
   {
+    mbot::app::RegisterSources();
     auto s = mbot::config::Section::Describe("source");
     mbot::drivers::ParseSourceOptions(s);
-    describe("[source]", "the input dataset", s);
+    describe("[source]", "the input dataset (mbot_nav --list-sources for the types)", s);
   }
   for (const auto& t : mbot::app::StageTypes()) {
     auto s = mbot::config::Section::Describe(t.name);
     t.create(s);
     describe("stage type " + t.name, t.doc, s);
   }
+}
+
+void ListSources() {
+  mbot::app::RegisterSources();
+  std::cout << "[source] type = auto detects the type from the path and the file's content; the types:\n";
+  for (const auto& t : mbot::drivers::SourceTypes()) std::cout << "  " << t.name << "\n      " << t.doc << "\n";
 }
 
 }  // namespace
@@ -89,6 +97,9 @@ int main(int argc, char** argv) {
       print_config = true;
     } else if (a == "--list-stages") {
       ListStages();
+      return 0;
+    } else if (a == "--list-sources") {
+      ListSources();
       return 0;
     } else if (a == "--quiet") {
       mbot::log::SetLevel(mbot::log::Level::kWarn);

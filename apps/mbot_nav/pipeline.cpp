@@ -100,6 +100,7 @@ PipelinePlan BuildPlan(const config::Config& config) {
   }
   {
     config::Section s = config.GetSection("source");
+    RegisterSources();
     plan.source = drivers::ParseSourceOptions(s);
     s.Finish();
   }

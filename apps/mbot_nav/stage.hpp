@@ -64,4 +64,8 @@ struct StageType {
 const std::vector<StageType>& StageTypes();
 const StageType* FindStageType(const std::string& name);
 
+// Registers the source types other libraries bring (libs/sim: sim) beside libs/drivers' own.
+// Idempotent; BuildPlan and --list-sources call it.
+void RegisterSources();
+
 }  // namespace mbot::app

@@ -7,6 +7,7 @@
 
 #include "../regression/run_config.hpp"
 #include "competition.hpp"
+#include "mbot/sim/sim_source_options.hpp"
 
 namespace mbot::app {
 namespace {
@@ -183,7 +184,7 @@ TEST(Competition, RunsTheListedEventsOnlyWithOverrides) {
   c.Set("maze_explorer.set=source.start=0, 0, 90; mission.max_speed_m_s=0.25");
   CompetitionPlan plan = BuildCompetition(c);
   ASSERT_EQ(plan.events.size(), 1u);
-  EXPECT_EQ(plan.events[0].plan.source.sim.start->theta, M_PI / 2);
+  EXPECT_EQ(std::any_cast<const sim::SimSourceOptions&>(plan.events[0].plan.source.extra).start->theta, M_PI / 2);
   EXPECT_NE(plan.events[0].plan.source.path.find("maze_2.arena"), std::string::npos);
 }
 

@@ -11,7 +11,7 @@
 
 #include "mbot/common/config.hpp"
 #include "mbot/drivers/map_io.hpp"
-#include "mbot/drivers/sim_world.hpp"
+#include "mbot/sim/world.hpp"
 #include "mbot/mission/mission_config.hpp"
 #include "stage.hpp"
 
@@ -20,14 +20,14 @@ namespace {
 
 namespace warehouse = mission::warehouse;
 
-drivers::World Warehouse() { return drivers::World::Load(std::string(MBOT_SOURCE_DIR) + "/datasets/arenas/warehouse.arena"); }
+sim::World Warehouse() { return sim::World::Load(std::string(MBOT_SOURCE_DIR) + "/datasets/arenas/warehouse.arena"); }
 
-std::vector<warehouse::Stop> StopsOf(const drivers::World& w, uint64_t seed) {
+std::vector<warehouse::Stop> StopsOf(const sim::World& w, uint64_t seed) {
   return warehouse::Stops(w.PosesLabelled("target"), w.PosesLabelled("dropoff"), seed);
 }
 
 TEST(WarehouseRules, SevenDeliveriesToDistinctTargetsEachOnToADropOff) {
-  const drivers::World w = Warehouse();
+  const sim::World w = Warehouse();
   const std::vector<warehouse::Stop> stops = StopsOf(w, 1);
   ASSERT_EQ(warehouse::TotalDeliveries(), 7);
   ASSERT_EQ(stops.size(), 14u);
@@ -44,7 +44,7 @@ TEST(WarehouseRules, SevenDeliveriesToDistinctTargetsEachOnToADropOff) {
 }
 
 TEST(WarehouseRules, TheSeedDecidesTheOrder) {
-  const drivers::World w = Warehouse();
+  const sim::World w = Warehouse();
   auto order = [&](uint64_t seed) {
     std::vector<int> o;
     for (const auto& s : StopsOf(w, seed)) o.push_back(s.index);
@@ -55,7 +55,7 @@ TEST(WarehouseRules, TheSeedDecidesTheOrder) {
 }
 
 TEST(WarehouseRules, AnArenaWithoutEnoughTargetsIsNamed) {
-  const drivers::World w = drivers::World::ParseArena("name tiny\nbox 0 0 2 2\npose target 1 1 0\npose dropoff 0.5 0.5 0\n", "tiny.arena");
+  const sim::World w = sim::World::ParseArena("name tiny\nbox 0 0 2 2\npose target 1 1 0\npose dropoff 0.5 0.5 0\n", "tiny.arena");
   try {
     StopsOf(w, 1);
     ADD_FAILURE();
@@ -163,18 +163,18 @@ TEST(DayInputs, TheShippedKeysAreTheShippedArenas) {
       EXPECT_NEAR(motion::WrapAngle(a[i].theta - b[i].theta), 0.0, 1e-9) << what << " " << i;
     }
   };
-  const drivers::World warehouse = Warehouse();
-  const drivers::EventInputs day = drivers::EventInputsOf(warehouse);
+  const sim::World warehouse = Warehouse();
+  const sim::EventInputs day = sim::EventInputsOf(warehouse);
   const mission::MissionOptions w = mission_of("warehouse.ini");
   expect_same(w.targets, day.targets, "targets");
   expect_same(w.dropoffs, day.dropoffs, "drop-offs");
   const mission::MissionOptions s = mission_of("speed_run.ini");
-  expect_same(s.waypoints, drivers::EventInputsOf(drivers::World::Load(dir + "/datasets/arenas/convex_circuit.arena")).waypoints,
+  expect_same(s.waypoints, sim::EventInputsOf(sim::World::Load(dir + "/datasets/arenas/convex_circuit.arena")).waypoints,
               "waypoints");
   // The given map is the arena drawn at the SLAM resolution.
   std::string format;
   const mapping::OccupancyGrid shipped = drivers::ReadAnyMap(dir + "/datasets/arenas/warehouse.map", &format);
-  const mapping::OccupancyGrid rendered = drivers::RenderKnownMap(warehouse, 0.05);
+  const mapping::OccupancyGrid rendered = sim::RenderKnownMap(warehouse, 0.05);
   ASSERT_EQ(shipped.width(), rendered.width());
   ASSERT_EQ(shipped.height(), rendered.height());
   EXPECT_NEAR(shipped.origin_x(), rendered.origin_x(), 1e-9);

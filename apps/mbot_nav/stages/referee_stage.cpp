@@ -16,7 +16,7 @@
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/drivers/map_io.hpp"
-#include "mbot/drivers/sim_world.hpp"
+#include "mbot/sim/world.hpp"
 #include "report.hpp"
 #include "stages.hpp"
 #include "mbot/mission/warehouse_rules.hpp"
@@ -73,7 +73,7 @@ class RefereeStage : public Stage {
 
   void Start(const RunContext& ctx) override {
     bus_ = ctx.bus;
-    world_ = drivers::World::Load(ctx.source_path);
+    world_ = sim::World::Load(ctx.source_path);
     if (o_.event == "warehouse") {
       try {
         stops_ = warehouse::Stops(world_.PosesLabelled("target"), world_.PosesLabelled("dropoff"), ctx.seed);
@@ -284,7 +284,7 @@ class RefereeStage : public Stage {
   MapQuality Quality(const mapping::OccupancyGrid& m, const Pose2D& start) const {
     MapQuality q;
     const mapping::OccupancyGrid& truth = world_.truth();
-    const std::vector<uint8_t> reach = drivers::ReachableFreeMask(world_, start);
+    const std::vector<uint8_t> reach = sim::ReachableFreeMask(world_, start);
     const Pose2D inv = start.Inverse();
     int mapped = 0;
     for (int cy = 0; cy < truth.height(); ++cy) {
@@ -380,7 +380,7 @@ class RefereeStage : public Stage {
 
   RefereeOptions o_;
   Bus* bus_ = nullptr;
-  drivers::World world_;
+  sim::World world_;
   std::chrono::steady_clock::time_point wall0_;
   int64_t t0_us_ = -1, last_us_ = 0, end_us_ = -1;
   std::vector<TimedPose> truth_, slam_;

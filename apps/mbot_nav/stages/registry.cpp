@@ -1,5 +1,6 @@
 #include <algorithm>
 
+#include "mbot/sim/sim_source.hpp"
 #include "stages.hpp"
 
 namespace mbot::app {
@@ -16,6 +17,8 @@ const std::vector<StageType>& StageTypes() {
   }();
   return types;
 }
+
+void RegisterSources() { sim::RegisterSimSource(); }
 
 const StageType* FindStageType(const std::string& name) {
   for (const auto& t : StageTypes()) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -19,7 +20,6 @@
 #include "motor_samples_source.hpp"
 #include "planning_cases_source.hpp"
 #include "rawlog_source.hpp"
-#include "sim_source.hpp"
 
 namespace mbot::drivers {
 namespace {
@@ -45,94 +45,7 @@ class MapSource : public Source {
   bool done_ = false;
 };
 
-// "x, y, theta_deg" → a pose (theta in radians).
-motion::Pose2D ParsePoseKey(config::Section& s, const std::string& key, const std::vector<std::string>& items) {
-  if (items.size() != 3) {
-    s.Fail(key, "expected x, y, theta_deg (3 numbers), got " + std::to_string(items.size()) + " items");
-  }
-  double v[3];
-  for (int i = 0; i < 3; ++i) {
-    char* end = nullptr;
-    v[i] = std::strtod(items[i].c_str(), &end);
-    if (*end != '\0' || !std::isfinite(v[i])) s.Fail(key, "expected a finite number, got '" + items[i] + "'");
-  }
-  return {v[0], v[1], motion::WrapAngle(v[2] * M_PI / 180.0)};
-}
-
 }  // namespace
-
-SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& world_path) {
-  // Every key is documented as the simulator's: they exist only when the source is the simulator.
-  const auto doc = [](const char* text) { return std::string("simulator: ") + text; };
-  SimSourceOptions o;
-  const std::vector<std::string> start =
-      s.GetList("start", {}, doc("where the robot starts, in the world frame: x [m], y [m], theta [deg], or 'random' "
-                                 "(a seeded draw from the reachable free space); default: the arena's 'start' pose "
-                                 "(required for a map world)"));
-  o.random_start_clearance_m = s.GetDouble("random_start_clearance_m", o.random_start_clearance_m,
-                                           doc("start = random keeps this far from every wall [m]"), 0.0, 10.0);
-  if (start.size() == 1 && start[0] == "random") {
-    o.random_start = true;
-  } else if (!start.empty()) {
-    o.start = ParsePoseKey(s, "start", start);
-  } else if (!s.describing() && !EndsWith(world_path, ".arena")) {
-    s.Fail("start", "required: the world '" + world_path + "' is a map, which names no start pose");
-  }
-  o.duration_s = s.GetDouble("duration_s", o.duration_s, doc("simulated time after which the run ends [s]"), 0.001, 1e6);
-  o.realtime_factor = s.GetDouble("realtime_factor", o.realtime_factor,
-                                  doc("0: as fast as possible; else simulated time runs this many times the wall clock "
-                                      "(1 for the simulated robot on the LCM bus)"), 0.0, 1000.0);
-  if (o.realtime_factor > 0 && o.realtime_factor < 0.01) s.Fail("realtime_factor", "must be 0 (off) or at least 0.01");
-
-  SimRobotOptions& r = o.robot;
-  r.physics_dt_s = s.GetDouble("physics_dt_s", r.physics_dt_s, doc("integration step of the motion [s]"), 1e-4, 0.02);
-  r.footprint_radius_m =
-      s.GetDouble("footprint_radius_m", r.footprint_radius_m,
-                  doc("radius of the robot's disc footprint; touching a wall with it stops the robot [m]"), 0.01, 1.0);
-  r.left_motor_gain =
-      s.GetDouble("left_motor_gain", r.left_motor_gain,
-                  doc("true left wheel speed / the speed the motor model gives its duty (per-wheel difference)"), 0.5, 1.5);
-  r.right_motor_gain = s.GetDouble("right_motor_gain", r.right_motor_gain,
-                                   doc("true right wheel speed / the speed the motor model gives its duty"), 0.5, 1.5);
-  r.motor_time_constant_s =
-      s.GetDouble("motor_time_constant_s", r.motor_time_constant_s,
-                  doc("first-order lag of a wheel's speed behind its duty's steady state [s]"), 0.0, 1.0);
-  r.slip_stddev = s.GetDouble("slip_stddev", r.slip_stddev,
-                              doc("relative error of each wheel's ground speed against its rotation (std. dev.)"), 0.0, 0.5);
-  r.slip_interval_s =
-      s.GetDouble("slip_interval_s", r.slip_interval_s, doc("how often each wheel's slip is redrawn [s]"), 0.001, 10.0);
-  const double firmware_rate_hz =
-      s.GetDouble("firmware_rate_hz", 1.0 / r.controller.dt_s,
-                  doc("rate of the firmware's wheel-speed controller and its encoder, wheel-speed, odometry and PWM "
-                      "messages [Hz]"),
-                  5.0, 1000.0);
-  r.controller.dt_s = 1.0 / firmware_rate_hz;
-  r.ground_truth_rate_hz =
-      s.GetDouble("ground_truth_rate_hz", r.ground_truth_rate_hz, doc("rate of the TRUE_POSE messages [Hz]"), 1.0, 1000.0);
-
-  SimImuOptions& imu = r.imu;
-  imu.rate_hz = s.GetDouble("imu_rate_hz", imu.rate_hz, doc("rate of the IMU messages [Hz]"), 1.0, 1000.0);
-  imu.gyro_noise_rad_s = s.GetDouble("gyro_noise_rad_s", imu.gyro_noise_rad_s,
-                                     doc("white noise of each gyro sample, standard deviation [rad/s]"), 0.0, 1.0);
-  imu.gyro_bias_initial_rad_s = s.GetDouble("gyro_bias_initial_rad_s", imu.gyro_bias_initial_rad_s,
-                                            doc("standard deviation of the gyro bias at start [rad/s]"), 0.0, 1.0);
-  imu.gyro_bias_walk_rad_s_sqrt_s = s.GetDouble("gyro_bias_walk_rad_s_sqrt_s", imu.gyro_bias_walk_rad_s_sqrt_s,
-                                                doc("random walk of the gyro bias [rad/s/sqrt(s)]"), 0.0, 1.0);
-
-  SimLidarOptions& l = r.lidar;
-  l.rate_hz = s.GetDouble("lidar_rate_hz", l.rate_hz, doc("lidar revolutions per second [Hz]"), 0.5, 100.0);
-  l.beams = static_cast<int>(s.GetInt("lidar_beams", l.beams, doc("lidar beams per revolution"), 8, 100000));
-  l.max_range_m = s.GetDouble("lidar_max_range_m", l.max_range_m,
-                              doc("lidar range limit; farther walls give no return [m]"), 0.5, 100.0);
-  l.min_range_m =
-      s.GetDouble("lidar_min_range_m", l.min_range_m, doc("closer lidar returns are dropped [m]"), 0.0, 10.0);
-  if (l.min_range_m >= l.max_range_m) s.Fail("lidar_min_range_m", "must be below lidar_max_range_m");
-  l.range_noise_m =
-      s.GetDouble("lidar_range_noise_m", l.range_noise_m, doc("lidar range noise, standard deviation [m]"), 0.0, 1.0);
-  l.dropout =
-      s.GetDouble("lidar_dropout", l.dropout, doc("probability that a lidar beam gives no return"), 0.0, 1.0);
-  return o;
-}
 
 LiveSourceOptions ParseLiveSourceOptions(config::Section& s) {
   const auto doc = [](const char* text) { return std::string("lcm_live: ") + text; };
@@ -149,15 +62,95 @@ LiveSourceOptions ParseLiveSourceOptions(config::Section& s) {
   return o;
 }
 
+namespace {
+
+bool IsCarmenText(const std::string& path) {
+  // Text (possibly gzip-compressed): CARMEN logs start with comments or message names.
+  gzFile f = gzopen(path.c_str(), "rb");
+  if (!f) return false;
+  char buf[256] = {0};
+  const int n = gzread(f, buf, sizeof buf - 1);
+  gzclose(f);
+  if (n <= 0) return false;
+  const std::string text(buf, n);
+  for (const char* tag : {"#", "PARAM", "ODOM", "FLASER", "RLASER", "ROBOTLASER", "RAWLASER", "TRUEPOS", "SYNC"}) {
+    if (text.rfind(tag, 0) == 0) return true;
+  }
+  return false;
+}
+
+bool IsLcmLog(const std::string& path) {
+  unsigned char head[4] = {0, 0, 0, 0};
+  std::ifstream in(path, std::ios::binary);
+  in.read(reinterpret_cast<char*>(head), 4);
+  const uint32_t word = (uint32_t(head[0]) << 24) | (uint32_t(head[1]) << 16) | (uint32_t(head[2]) << 8) | head[3];
+  return in.gcount() == 4 && word == LcmLogReader::kSyncWord;
+}
+
+bool IsCases(const std::string& path, const char* type) {
+  std::string cases;
+  return IsPlanningCasesPath(path, &cases) && cases == type;
+}
+
+// libs/drivers' own types; detect_order < 0 may name a folder, the others need a regular file.
+std::vector<SourceType> BuiltInTypes() {
+  std::vector<SourceType> t;
+  t.push_back({"astar_cases", "the botlab A* test cases: a folder of *_poses.txt files beside their maps, or one of them",
+               [](const std::string& p) { return IsCases(p, "astar_cases"); }, -1, nullptr,
+               [](const SourceOptions& o) { return std::make_unique<PlanningCasesSource>(o.path, "astar_cases"); }});
+  t.push_back({"movingai", "a Moving AI .map.scen scenario file (its map beside it, or in ../../maps)",
+               [](const std::string& p) { return IsCases(p, "movingai"); }, -1, nullptr,
+               [](const SourceOptions& o) { return std::make_unique<PlanningCasesSource>(o.path, "movingai"); }});
+  t.push_back({"map", "a map file (botlab .map, PGM + YAML, MRPT .gridmap/.simplemap, Moving AI .map): one map event",
+               [](const std::string& p) { return IsMapFile(p); }, 0, nullptr,
+               [](const SourceOptions& o) { return std::make_unique<MapSource>(o.path); }});
+  t.push_back({"rawlog", "an MRPT rawlog (.rawlog, .rawlog.gz), both formats",
+               [](const std::string& p) { return EndsWith(p, ".rawlog") || EndsWith(p, ".rawlog.gz"); }, 0, nullptr,
+               [](const SourceOptions& o) { return std::make_unique<RawlogSource>(o); }});
+  t.push_back({"motor_csv", "a motor calibration CSV (duty and wheel speed per channel)",
+               [](const std::string& p) { return EndsWith(p, ".csv") && IsMotorSamplesFile(p); }, 0, nullptr,
+               [](const SourceOptions& o) { return std::make_unique<MotorSamplesSource>(o.path); }});
+  t.push_back({"lcm_log", "an LCM log (lcm-logger), every botlab message generation", IsLcmLog, 10, nullptr,
+               [](const SourceOptions& o) { return std::make_unique<LcmLogSource>(o); }});
+  t.push_back({"carmen", "a CARMEN log, plain or gzip", IsCarmenText, 20, nullptr,
+               [](const SourceOptions& o) { return std::make_unique<CarmenSource>(o); }});
+  t.push_back({"lcm_live", "a robot (or the simulated one) on the LCM bus, in wall-clock time; path is the LCM url", nullptr, 0,
+               [](config::Section& s, SourceOptions* o) { o->live = ParseLiveSourceOptions(s); },
+               [](const SourceOptions& o) { return std::make_unique<LcmLiveSource>(o); }});
+  return t;
+}
+
+std::vector<SourceType>& Registry() {
+  static std::vector<SourceType> types = BuiltInTypes();
+  return types;
+}
+
+}  // namespace
+
+void RegisterSourceType(SourceType type) {
+  if (FindSourceType(type.name)) throw std::logic_error("source type '" + type.name + "' is registered twice");
+  Registry().push_back(std::move(type));
+}
+
+const std::vector<SourceType>& SourceTypes() { return Registry(); }
+
+const SourceType* FindSourceType(const std::string& name) {
+  for (const SourceType& t : Registry()) {
+    if (t.name == name) return &t;
+  }
+  return nullptr;
+}
+
 SourceOptions ParseSourceOptions(config::Section& s) {
   SourceOptions o;
-  o.type = s.GetChoice("type", o.type, {"auto", "lcm_log", "rawlog", "carmen", "map", "astar_cases", "movingai", "motor_csv", "sim", "lcm_live"},
-                       "input format; auto detects it from the file's content (an .arena file is the simulator's world); "
-                       "lcm_live: a robot on the LCM bus");
+  std::vector<std::string> names = {"auto"};
+  for (const SourceType& t : SourceTypes()) names.push_back(t.name);
+  o.type = s.GetChoice("type", o.type, names,
+                       "input format; auto detects it from the path and the file's content (an .arena file is the "
+                       "simulator's world); lcm_live: a robot on the LCM bus (mbot_nav --list-sources)");
   const bool live = o.type == "lcm_live";
   if (live || s.describing()) {
     o.path = s.GetString("url", kDefaultLcmUrl, "lcm_live: the LCM URL (ttl=0 keeps the traffic on this machine)");
-    o.live = ParseLiveSourceOptions(s);
   }
   if (!live) {
     o.path = s.RequirePath("path", "the dataset to read (LCM log, MRPT rawlog, CARMEN log, map file, botlab A* poses file or folder, Moving AI .scen), or the simulator's world (.arena or a map)");
@@ -176,56 +169,45 @@ SourceOptions ParseSourceOptions(config::Section& s) {
   o.reorder_window_us = static_cast<int64_t>(
       1e6 * s.GetDouble("reorder_window_s", o.reorder_window_us * 1e-6,
                         "LCM log records are re-sorted by event time within this window [s]", 0.0, 10.0));
-  // The simulator's keys exist only for the simulator (elsewhere they are unknown keys); --list-stages
-  // (describe mode) documents them too.
-  if (o.type == "sim" || (o.type == "auto" && EndsWith(o.path, ".arena")) || s.describing()) {
-    o.sim = ParseSimSourceOptions(s, o.path);
+  // A type's own keys exist only for that type (elsewhere they are unknown keys); describe mode
+  // (--list-stages) documents every type's. With type = auto the type is detected now when the
+  // path exists (otherwise opening it says what is wrong).
+  if (s.describing()) {
+    for (const SourceType& t : SourceTypes()) {
+      if (t.parse) t.parse(s, &o);
+    }
+    return o;
   }
+  std::string type = o.type;
+  if (type == "auto" && std::filesystem::exists(o.path)) type = DetectFormat(o.path);
+  if (const SourceType* t = FindSourceType(type); t && t->parse) t->parse(s, &o);
   return o;
 }
 
 std::string DetectFormat(const std::string& path) {
-  std::string cases;
-  if (IsPlanningCasesPath(path, &cases)) return cases;
-  if (!std::filesystem::is_regular_file(path)) throw std::runtime_error(path + ": no such file");
-  if (EndsWith(path, ".arena")) return "sim";
-  if (IsMapFile(path)) return "map";
-  if (EndsWith(path, ".rawlog") || EndsWith(path, ".rawlog.gz")) return "rawlog";
-  if (EndsWith(path, ".csv") && IsMotorSamplesFile(path)) return "motor_csv";
-  unsigned char head[4] = {0, 0, 0, 0};
-  {
-    std::ifstream in(path, std::ios::binary);
-    in.read(reinterpret_cast<char*>(head), 4);
+  std::vector<const SourceType*> ordered;
+  for (const SourceType& t : SourceTypes()) {
+    if (t.detect) ordered.push_back(&t);
   }
-  const uint32_t word = (uint32_t(head[0]) << 24) | (uint32_t(head[1]) << 16) | (uint32_t(head[2]) << 8) | head[3];
-  if (word == LcmLogReader::kSyncWord) return "lcm_log";
-  // Text (possibly gzip-compressed): CARMEN logs start with comments or message names.
-  gzFile f = gzopen(path.c_str(), "rb");
-  if (f) {
-    char buf[256] = {0};
-    const int n = gzread(f, buf, sizeof buf - 1);
-    gzclose(f);
-    if (n > 0) {
-      const std::string text(buf, n);
-      for (const char* tag : {"#", "PARAM", "ODOM", "FLASER", "RLASER", "ROBOTLASER", "RAWLASER", "TRUEPOS", "SYNC"}) {
-        if (text.rfind(tag, 0) == 0) return "carmen";
-      }
+  std::stable_sort(ordered.begin(), ordered.end(),
+                   [](const SourceType* a, const SourceType* b) { return a->detect_order < b->detect_order; });
+  bool checked_file = false;
+  for (const SourceType* t : ordered) {
+    if (t->detect_order >= 0 && !checked_file) {
+      checked_file = true;
+      if (std::filesystem::is_directory(path)) throw std::runtime_error(path + ": is a directory, not a dataset file");
+      if (!std::filesystem::is_regular_file(path)) throw std::runtime_error(path + ": no such file");
     }
+    if (t->detect(path)) return t->name;
   }
   throw std::runtime_error(path + ": unrecognised format (not an LCM log, MRPT rawlog, CARMEN log, map or arena); set source.type");
 }
 
 std::unique_ptr<Source> OpenSource(const SourceOptions& options) {
   const std::string type = options.type == "auto" ? DetectFormat(options.path) : options.type;
-  if (type == "lcm_log") return std::make_unique<LcmLogSource>(options);
-  if (type == "rawlog") return std::make_unique<RawlogSource>(options);
-  if (type == "carmen") return std::make_unique<CarmenSource>(options);
-  if (type == "map") return std::make_unique<MapSource>(options.path);
-  if (type == "astar_cases" || type == "movingai") return std::make_unique<PlanningCasesSource>(options.path, type);
-  if (type == "sim") return std::make_unique<SimSource>(options);
-  if (type == "motor_csv") return std::make_unique<MotorSamplesSource>(options.path);
-  if (type == "lcm_live") return std::make_unique<LcmLiveSource>(options);
-  throw std::runtime_error("source type '" + type + "' is not known");
+  const SourceType* t = FindSourceType(type);
+  if (!t) throw std::runtime_error("source type '" + type + "' is not known");
+  return t->open(options);
 }
 
 const char* ToString(EventKind kind) {

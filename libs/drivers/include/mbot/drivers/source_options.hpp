@@ -1,11 +1,12 @@
 // [source]: which dataset to read and how to interpret its channels.
 #pragma once
 
+#include <any>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "mbot/drivers/sim_source_options.hpp"
 #include "mbot/drivers/source.hpp"
 
 namespace mbot::config {
@@ -41,7 +42,7 @@ struct LiveSourceOptions {
 };
 
 struct SourceOptions {
-  std::string type = "auto";  // auto, lcm_log, rawlog, carmen, map, astar_cases, movingai, sim, lcm_live
+  std::string type = "auto";  // a registered source type (SourceTypes()), or auto
   std::string path;           // required; for sim, the world file; for lcm_live, the LCM URL
   ChannelRoles roles;
   // CARMEN logs with old FLASER lines give no range limit; beams at or beyond it are no-returns.
@@ -49,26 +50,52 @@ struct SourceOptions {
   // LCM log records are re-sorted by event time within this window (lcm-logger writes them in
   // arrival order, which can run a few ms backwards).
   int64_t reorder_window_us = 100000;
-  // Seed of the simulator's noise ([pipeline] seed, copied here by the pipeline; not a [source] key).
+  // Seed of the source's randomness, e.g. the simulator's noise ([pipeline] seed, copied here by
+  // the pipeline; not a [source] key).
   uint64_t seed = 1;
-  // The simulator's options: read only when the source is the simulator (type = sim, or auto with
-  // an `.arena` path).
-  SimSourceOptions sim;
   LiveSourceOptions live;  // read only when type = lcm_live
+  // The options of a source type registered by another library (the simulator's SimSourceOptions),
+  // filled by that type's `parse`.
+  std::any extra;
 };
 
-// Reads [source]. Throws config::ConfigError naming the key on bad values.
+// A source type, registered by name like the stage types: what it reads, how its files are
+// recognised (type = auto), its own keys of [source], and how it opens. libs/drivers registers
+// the dataset and LCM types itself; another library registers its own (libs/sim: sim).
+struct SourceType {
+  std::string name;  // the [source] type value
+  std::string doc;
+  // True when `path` is this type's input (type = auto). Types are asked in order of
+  // `detect_order` (extension checks before content sniffing), then of registration. May be empty.
+  std::function<bool(const std::string& path)> detect;
+  int detect_order = 0;
+  // Reads the type's own keys of [source] into `options` (documents them in describe mode). May be
+  // empty when the type has none beyond the common ones.
+  std::function<void(config::Section& section, SourceOptions* options)> parse;
+  // Opens the input. Throws std::runtime_error naming the path when it cannot be read.
+  std::function<std::unique_ptr<Source>(const SourceOptions& options)> open;
+};
+
+// Adds a type; a second type of the same name is an error (std::logic_error).
+void RegisterSourceType(SourceType type);
+// Every registered type, libs/drivers' own first, in registration order.
+const std::vector<SourceType>& SourceTypes();
+// nullptr when no type has that name.
+const SourceType* FindSourceType(const std::string& name);
+
+// Reads [source]: the common keys, then the chosen type's own (with type = auto, the type detected
+// from the path when it exists). Throws config::ConfigError naming the key on bad values.
 SourceOptions ParseSourceOptions(config::Section& section);
 // The lcm_live keys of [source].
 LiveSourceOptions ParseLiveSourceOptions(config::Section& section);
 
 // Opens the input named by the options, detecting the format from its content when type = auto.
-// The simulator (type sim) is also a Sink: dynamic_cast the source to drivers::Sink to drive it.
+// A source that is also a Sink (the simulator, live LCM) is driven through dynamic_cast to Sink.
 // Throws std::runtime_error naming the path when it cannot be read or recognised.
 std::unique_ptr<Source> OpenSource(const SourceOptions& options);
 
-// The format OpenSource would pick for `path` ("lcm_log", "rawlog", "carmen", "map", "astar_cases",
-// "movingai", "sim" for an `.arena` world).
+// The type OpenSource would pick for `path` (the first registered type whose `detect` accepts it).
+// Throws std::runtime_error naming the path when there is no such file or no type recognises it.
 std::string DetectFormat(const std::string& path);
 
 }  // namespace mbot::drivers

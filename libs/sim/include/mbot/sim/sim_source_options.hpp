@@ -5,14 +5,14 @@
 #include <optional>
 #include <string>
 
-#include "mbot/drivers/sim_robot.hpp"
+#include "mbot/sim/sim_robot.hpp"
 #include "mbot/motion/pose2d.hpp"
 
 namespace mbot::config {
 class Section;
 }
 
-namespace mbot::drivers {
+namespace mbot::sim {
 
 struct SimSourceOptions {
   // World frame. Unset: the world file's `start` pose (an `.arena` file's `pose start …` line);
@@ -33,4 +33,4 @@ struct SimSourceOptions {
 // is required. Throws config::ConfigError naming the key.
 SimSourceOptions ParseSimSourceOptions(config::Section& section, const std::string& world_path);
 
-}  // namespace mbot::drivers
+}  // namespace mbot::sim

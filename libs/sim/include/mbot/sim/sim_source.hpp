@@ -11,20 +11,22 @@
 #include <utility>
 #include <vector>
 
-#include "mbot/drivers/sim_robot.hpp"
-#include "mbot/drivers/sim_world.hpp"
+#include "mbot/sim/sim_robot.hpp"
+#include "mbot/sim/world.hpp"
 #include "mbot/drivers/sink.hpp"
 #include "mbot/drivers/source.hpp"
 #include "mbot/drivers/source_options.hpp"
+#include "mbot/sim/sim_source_options.hpp"
 
-namespace mbot::drivers {
+namespace mbot::sim {
 
-class SimSource : public Source, public Sink {
+class SimSource : public drivers::Source, public drivers::Sink {
  public:
-  // Loads options.path as the world (World::Load) and places the robot at options.sim.start, or at
-  // the world's `start` pose. Throws std::runtime_error naming the path (and [source] start when the
-  // world has no start pose) or std::invalid_argument when the start collides.
-  explicit SimSource(const SourceOptions& options);
+  // Loads options.path as the world (World::Load) and places the robot at sim.start, or at the
+  // world's `start` pose; options.seed seeds its noise. Throws std::runtime_error naming the path
+  // (and [source] start when the world has no start pose) or std::invalid_argument when the start
+  // collides.
+  SimSource(const drivers::SourceOptions& options, const SimSourceOptions& sim);
   SimSource(const SimSource&) = delete;  // the robot holds a reference to world_
   SimSource& operator=(const SimSource&) = delete;
 
@@ -62,4 +64,9 @@ class SimSource : public Source, public Sink {
   bool ended_ = false;
 };
 
-}  // namespace mbot::drivers
+// Registers the source type `sim` (an `.arena` path is detected as one; its keys are
+// SimSourceOptions'). Called once by the application before it parses a configuration; a second
+// call does nothing.
+void RegisterSimSource();
+
+}  // namespace mbot::sim

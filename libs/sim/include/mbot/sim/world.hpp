@@ -14,7 +14,7 @@
 #include "mbot/mapping/occupancy_grid.hpp"
 #include "mbot/motion/pose2d.hpp"
 
-namespace mbot::drivers {
+namespace mbot::sim {
 
 struct WallSegment {
   double x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // [m]
@@ -115,4 +115,4 @@ EventInputs EventInputsOf(const World& world);
 // gives the same pose. Throws when 10,000 draws find no such place.
 motion::Pose2D RandomFreePose(const World& world, double clearance_m, uint64_t seed);
 
-}  // namespace mbot::drivers
+}  // namespace mbot::sim

@@ -1,4 +1,4 @@
-#include "mbot/drivers/sim_robot.hpp"
+#include "mbot/sim/sim_robot.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,11 +12,13 @@
 
 #include "mbot/common/config.hpp"
 #include "mbot/drivers/source_options.hpp"
-#include "sim_source.hpp"
-#include "test_util.hpp"
+#include "mbot/sim/sim_source.hpp"
+#include "../drivers/test_util.hpp"
 
-namespace mbot::drivers {
+namespace mbot::sim {
 namespace {
+
+using namespace mbot::drivers;  // the event and source types the simulator speaks
 
 using motion::Pose2D;
 
@@ -286,6 +288,7 @@ std::string WriteArena(const std::string& name, const std::string& text) {
 const char* kRoom = "name room\nbox -1.5 -1 1.5 1\npose start -0.5 0 0\n";
 
 SourceOptions ParseSource(const std::string& ini) {
+  RegisterSimSource();
   const auto config = config::Config::FromString(ini, "t.ini");
   config::Section s = config.GetSection("source");
   SourceOptions o = ParseSourceOptions(s);
@@ -304,9 +307,10 @@ std::string ConfigErrorOf(const std::string& ini) {
 
 TEST(SimSource, StreamIsTimeOrderedAndEndsAtDuration) {
   const std::string path = WriteArena("room.arena", kRoom);
+  RegisterSimSource();
   EXPECT_EQ(DetectFormat(path), "sim");
   SourceOptions o = ParseSource("[source]\npath = " + path + "\nduration_s = 1.5\n");  // type auto
-  EXPECT_DOUBLE_EQ(o.sim.duration_s, 1.5);
+  EXPECT_DOUBLE_EQ(std::any_cast<const SimSourceOptions&>(o.extra).duration_s, 1.5);
   auto source = OpenSource(o);
   EXPECT_EQ(source->Format(), "simulator");
   EXPECT_EQ(source->channels().size(), 8u);
@@ -334,8 +338,9 @@ TEST(SimSource, VelocityCommandsDriveTheRobot) {
   SourceOptions o;
   o.type = "sim";
   o.path = WriteArena("room_cmd.arena", kRoom);
-  o.sim.duration_s = 3.0;
-  SimSource sim(o);
+  SimSourceOptions so;
+  so.duration_s = 3.0;
+  SimSource sim(o, so);
   Sink& sink = sim;
   auto until = [&sim](double t_s) {
     while (auto e = sim.Next()) {
@@ -364,13 +369,14 @@ TEST(SimSource, OptionsAreStrictAndOnlyForTheSimulator) {
   const std::string base = "[source]\ntype = sim\npath = " + arena + "\n";
   const SourceOptions o = ParseSource(base + "start = 1, -0.5, 90\nlidar_beams = 720\nright_motor_gain = 0.9\n"
                                              "firmware_rate_hz = 100\n");
-  ASSERT_TRUE(o.sim.start.has_value());
-  EXPECT_DOUBLE_EQ(o.sim.start->x, 1.0);
-  EXPECT_DOUBLE_EQ(o.sim.start->theta, M_PI / 2);
-  EXPECT_EQ(o.sim.robot.lidar.beams, 720);
-  EXPECT_DOUBLE_EQ(o.sim.robot.right_motor_gain, 0.9);
-  EXPECT_DOUBLE_EQ(o.sim.robot.controller.dt_s, 0.01);
-  EXPECT_DOUBLE_EQ(o.sim.duration_s, 600.0);
+  const auto& so = std::any_cast<const SimSourceOptions&>(o.extra);
+  ASSERT_TRUE(so.start.has_value());
+  EXPECT_DOUBLE_EQ(so.start->x, 1.0);
+  EXPECT_DOUBLE_EQ(so.start->theta, M_PI / 2);
+  EXPECT_EQ(so.robot.lidar.beams, 720);
+  EXPECT_DOUBLE_EQ(so.robot.right_motor_gain, 0.9);
+  EXPECT_DOUBLE_EQ(so.robot.controller.dt_s, 0.01);
+  EXPECT_DOUBLE_EQ(so.duration_s, 600.0);
 
   std::string e = ConfigErrorOf(base + "lidar_beam = 720\n");
   EXPECT_NE(e.find("[source] lidar_beam: unknown key"), std::string::npos) << e;
@@ -381,7 +387,7 @@ TEST(SimSource, OptionsAreStrictAndOnlyForTheSimulator) {
   // A start in a wall is an error naming the world file.
   SourceOptions in_wall = ParseSource(base + "start = 1.45, 0, 0\n");
   try {
-    SimSource sim(in_wall);
+    SimSource sim(in_wall, std::any_cast<const SimSourceOptions&>(in_wall.extra));
     ADD_FAILURE() << "no error";
   } catch (const std::invalid_argument& err) {
     const std::string what = err.what();
@@ -410,8 +416,9 @@ TEST(SimSource, SpeedOnAMazeArena) {
   SourceOptions o;
   o.type = "sim";
   o.path = WriteArena("maze.arena", a.str());
-  o.sim.duration_s = 60.0;
-  SimSource sim(o);
+  SimSourceOptions so;
+  so.duration_s = 60.0;
+  SimSource sim(o, so);
   // A roaming robot: drive ahead, turn in place when a wall is near in front (a cheap bumper on the
   // true pose, every 10 ms, so the figure is for a moving robot, not one pushing against a wall).
   const auto t0 = std::chrono::steady_clock::now();
@@ -428,8 +435,8 @@ TEST(SimSource, SpeedOnAMazeArena) {
                    MotorCommand::Velocity(blocked ? 0.0 : 0.3, blocked ? 1.5 : 0.0)});
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const double speed = o.sim.duration_s / wall;
-  std::cout << "[ sim      ] " << n << " events, " << o.sim.duration_s << " s simulated in " << wall * 1e3
+  const double speed = so.duration_s / wall;
+  std::cout << "[ sim      ] " << n << " events, " << so.duration_s << " s simulated in " << wall * 1e3
             << " ms: " << speed << " x real time (" << sim.world().walls().size() << " walls, "
             << sim.robot().distance_travelled_m() << " m driven, " << sim.robot().collisions() << " collisions)\n";
   RecordProperty("sim_seconds_per_wall_second", std::to_string(speed));
@@ -438,4 +445,4 @@ TEST(SimSource, SpeedOnAMazeArena) {
 }
 
 }  // namespace
-}  // namespace mbot::drivers
+}  // namespace mbot::sim

@@ -1,4 +1,4 @@
-#include "sim_source.hpp"
+#include "mbot/sim/sim_source.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -7,14 +7,20 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace mbot::drivers {
+#include "mbot/common/strings.hpp"
+
+namespace mbot::sim {
 namespace {
 
-motion::Pose2D StartPose(const SourceOptions& options, const World& world) {
-  if (options.sim.start) return *options.sim.start;
-  if (options.sim.random_start) {
+using drivers::ChannelInfo;
+using drivers::MotorCommand;
+using drivers::SourceOptions;
+
+motion::Pose2D StartPose(const SourceOptions& options, const SimSourceOptions& sim, const World& world) {
+  if (sim.start) return *sim.start;
+  if (sim.random_start) {
     try {
-      return RandomFreePose(world, options.sim.random_start_clearance_m, options.seed);
+      return RandomFreePose(world, sim.random_start_clearance_m, options.seed);
     } catch (const std::runtime_error& e) {
       throw std::runtime_error(options.path + ": start = random: " + e.what());
     }
@@ -26,9 +32,10 @@ motion::Pose2D StartPose(const SourceOptions& options, const World& world) {
   return starts.front();
 }
 
-std::unique_ptr<SimRobot> MakeRobot(const SourceOptions& options, const World& world, const motion::Pose2D& start) {
+std::unique_ptr<SimRobot> MakeRobot(const SourceOptions& options, const SimSourceOptions& sim, const World& world,
+                                    const motion::Pose2D& start) {
   try {
-    return std::make_unique<SimRobot>(world, options.sim.robot, start, options.seed);
+    return std::make_unique<SimRobot>(world, sim.robot, start, options.seed);
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(options.path + ": " + e.what());
   }
@@ -36,14 +43,14 @@ std::unique_ptr<SimRobot> MakeRobot(const SourceOptions& options, const World& w
 
 }  // namespace
 
-SimSource::SimSource(const SourceOptions& options)
+SimSource::SimSource(const SourceOptions& options, const SimSourceOptions& sim)
     : path_(options.path),
       seed_(options.seed),
-      duration_us_(static_cast<int64_t>(std::llround(options.sim.duration_s * 1e6))),
+      duration_us_(static_cast<int64_t>(std::llround(sim.duration_s * 1e6))),
       world_(World::Load(options.path)),
-      start_(StartPose(options, world_)),
-      robot_(MakeRobot(options, world_, start_)),
-      realtime_factor_(options.sim.realtime_factor) {
+      start_(StartPose(options, sim, world_)),
+      robot_(MakeRobot(options, sim, world_, start_)),
+      realtime_factor_(sim.realtime_factor) {
   const std::string gen = "simulated";
   channels_[sim_channel::kEncoders] = ChannelInfo{"mbot_encoders_t", gen, EventKind::kEncoders, true};
   channels_[sim_channel::kImu] = ChannelInfo{"mbot_imu_t", gen, EventKind::kImu, true};
@@ -95,4 +102,17 @@ void SimSource::Send(const Event& event) {
   if (cmd && cmd->kind == MotorCommand::Kind::kVelocity) robot_->Command(cmd->velocity.v_m_s, cmd->velocity.w_rad_s);
 }
 
-}  // namespace mbot::drivers
+void RegisterSimSource() {
+  if (drivers::FindSourceType("sim")) return;
+  drivers::RegisterSourceType(
+      {"sim", "the simulated MBot on a world (.arena, or a map whose unknown and occupied cells are walls); its keys "
+              "are the simulator's",
+       [](const std::string& path) { return EndsWith(path, ".arena"); }, 0,
+       [](config::Section& s, SourceOptions* o) { o->extra = ParseSimSourceOptions(s, o->path); },
+       [](const SourceOptions& o) -> std::unique_ptr<drivers::Source> {
+         const auto* sim = std::any_cast<SimSourceOptions>(&o.extra);
+         return std::make_unique<SimSource>(o, sim ? *sim : SimSourceOptions{});
+       }});
+}
+
+}  // namespace mbot::sim

@@ -1,4 +1,4 @@
-#include "mbot/drivers/sim_world.hpp"
+#include "mbot/sim/world.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -14,7 +14,7 @@
 #include "mbot/common/strings.hpp"
 #include "mbot/drivers/map_io.hpp"
 
-namespace mbot::drivers {
+namespace mbot::sim {
 namespace fs = std::filesystem;
 
 namespace {
@@ -271,7 +271,7 @@ World World::Load(const std::string& path) {
   if (HasArenaExtension(path)) {
     w = ParseArena(ReadText(path), path);
   } else {
-    const mapping::OccupancyGrid grid = ReadAnyMap(path);  // names the file itself
+    const mapping::OccupancyGrid grid = drivers::ReadAnyMap(path);  // names the file itself
     try {
       w = FromGrid(grid);
     } catch (const std::exception& e) {
@@ -664,4 +664,4 @@ motion::Pose2D RandomFreePose(const World& world, double clearance_m, uint64_t s
                            " m from every wall (10,000 draws)");
 }
 
-}  // namespace mbot::drivers
+}  // namespace mbot::sim

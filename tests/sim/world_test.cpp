@@ -1,4 +1,4 @@
-#include "mbot/drivers/sim_world.hpp"
+#include "mbot/sim/world.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,10 +12,12 @@
 #include <vector>
 
 #include "mbot/drivers/map_io.hpp"
-#include "test_util.hpp"
+#include "../drivers/test_util.hpp"
 
-namespace mbot::drivers {
+namespace mbot::sim {
 namespace {
+
+using namespace mbot::drivers;  // the event and source types the simulator speaks
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -519,4 +521,4 @@ TEST(SimWorld, RandomFreePoseIsSeededAndKeepsItsClearance) {
 }
 
 }  // namespace
-}  // namespace mbot::drivers
+}  // namespace mbot::sim

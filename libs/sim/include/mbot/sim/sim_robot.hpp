@@ -29,12 +29,16 @@
 #include <vector>
 
 #include "mbot/drivers/events.hpp"
-#include "mbot/drivers/sim_world.hpp"
+#include "mbot/sim/world.hpp"
 #include "mbot/motion/gyrodometry.hpp"
 #include "mbot/motion/motor_model.hpp"
 #include "mbot/motion/wheel_controller.hpp"
 
-namespace mbot::drivers {
+namespace mbot::sim {
+
+// The simulator speaks the project's own event types (libs/drivers/events.hpp).
+using drivers::Event;
+using drivers::EventKind;
 
 // The channels the simulated robot publishes on.
 namespace sim_channel {
@@ -120,4 +124,4 @@ class SimRobot {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace mbot::drivers
+}  // namespace mbot::sim

@@ -1,4 +1,4 @@
-#include "mbot/drivers/sim_robot.hpp"
+#include "mbot/sim/sim_robot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,14 @@
 #include <stdexcept>
 #include <string>
 
-namespace mbot::drivers {
+namespace mbot::sim {
+
+using drivers::EncoderTicks;
+using drivers::Imu;
+using drivers::LidarScan;
+using drivers::MotorCommand;
+using drivers::Payload;
+using drivers::WheelSpeeds;
 namespace {
 
 using motion::Pose2D;
@@ -342,4 +349,4 @@ int64_t SimRobot::right_ticks() const {
 double SimRobot::gyro_bias_rad_s() const { return impl_->bias; }
 const SimRobotOptions& SimRobot::options() const { return impl_->o; }
 
-}  // namespace mbot::drivers
+}  // namespace mbot::sim
