@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "mbot/common/atomic_file.hpp"
 #include "mbot/motion/pose2d.hpp"
 #include "mbot/motion/trajectory_error.hpp"
 
@@ -90,6 +91,19 @@ inline std::string AteJson(const motion::AteResult& a) {
          ", \"xy_m\": " + StatsJson(a.xy) + ", \"theta_deg\": " + StatsJson(a.theta, 180.0 / M_PI) +
          ", \"final_error\": {\"x_m\": " + Num(a.final_error.x) + ", \"y_m\": " + Num(a.final_error.y) +
          ", \"theta_deg\": " + Num(a.final_error.theta * 180.0 / M_PI) + "}, \"alignment\": " + PoseJson(a.alignment) + "}";
+}
+
+// A TUM trajectory file (written whole or not at all): a comment line naming what it holds, then
+// one line per pose, each composed onto `frame` (the identity: as given).
+inline void WriteTum(const std::string& path, const std::string& what, const std::vector<motion::TimedPose>& poses,
+                     const motion::Pose2D& frame = {}) {
+  WriteFileAtomically(path, [&](std::ostream& o) {
+    o << "# " << what << (what.empty() ? "" : ": ") << "t x y z qx qy qz qw\n";
+    for (const motion::TimedPose& p : poses) {
+      const motion::Pose2D w = frame.Compose(p.pose);
+      o << TumLine(p.t_us * 1e-6, w.x, w.y, w.theta);
+    }
+  });
 }
 
 }  // namespace mbot::app

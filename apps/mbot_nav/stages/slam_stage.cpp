@@ -334,13 +334,6 @@ class SlamStage : public Stage {
     }
   }
 
-  void WriteTum(const std::string& path, const std::string& what, const std::vector<TimedPose>& poses) const {
-    WriteFileAtomically(path, [&](std::ostream& o) {
-      o << "# " << what << ": t x y z qx qy qz qw\n";
-      for (const TimedPose& p : poses) o << TumLine(p.t_us * 1e-6, p.pose.x, p.pose.y, p.pose.theta);
-    });
-  }
-
   void WriteOutputs(const RunContext& ctx, bool interrupted, double wall_s) {
     const std::string dir = ctx.output_dir + "/";
     const int64_t max_gap = static_cast<int64_t>(options_.max_pose_gap_s * 1e6);

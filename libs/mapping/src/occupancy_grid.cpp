@@ -1,5 +1,6 @@
 #include "mbot/mapping/occupancy_grid.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -39,6 +40,26 @@ OccupancyGrid::Stats OccupancyGrid::CountCells() const {
 bool OccupancyGrid::operator==(const OccupancyGrid& o) const {
   return width_ == o.width_ && height_ == o.height_ && resolution_ == o.resolution_ &&
          origin_x_ == o.origin_x_ && origin_y_ == o.origin_y_ && cells_ == o.cells_;
+}
+
+OccupancyGrid CropToKnown(const OccupancyGrid& m, double margin_m) {
+  int x0 = m.width(), y0 = m.height(), x1 = -1, y1 = -1;
+  for (int cy = 0; cy < m.height(); ++cy) {
+    for (int cx = 0; cx < m.width(); ++cx) {
+      if (m.at(cx, cy) == 0) continue;
+      x0 = std::min(x0, cx), x1 = std::max(x1, cx), y0 = std::min(y0, cy), y1 = std::max(y1, cy);
+    }
+  }
+  if (x1 < 0) return m;
+  const int pad = static_cast<int>(std::ceil(margin_m / m.resolution()));
+  x0 = std::max(0, x0 - pad), y0 = std::max(0, y0 - pad);
+  x1 = std::min(m.width() - 1, x1 + pad), y1 = std::min(m.height() - 1, y1 + pad);
+  OccupancyGrid c(x1 - x0 + 1, y1 - y0 + 1, m.resolution(), m.origin_x() + x0 * m.resolution(),
+                  m.origin_y() + y0 * m.resolution());
+  for (int cy = y0; cy <= y1; ++cy) {
+    for (int cx = x0; cx <= x1; ++cx) c.at(cx - x0, cy - y0) = m.at(cx, cy);
+  }
+  return c;
 }
 
 }  // namespace mbot::mapping

@@ -51,4 +51,8 @@ class OccupancyGrid {
   std::vector<int8_t> cells_;
 };
 
+// The grid's known cells (non-zero) and `margin_m` around them, in the same frame; the grid itself
+// when nothing is known. SLAM's map starts large; a picture of it need not.
+OccupancyGrid CropToKnown(const OccupancyGrid& grid, double margin_m);
+
 }  // namespace mbot::mapping

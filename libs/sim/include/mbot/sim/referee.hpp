@@ -1,0 +1,133 @@
+// The competition's judge (Winter 2024 rules): it watches an event on the simulator — the true pose,
+// collisions and the world, which only the simulator knows, beside what the stack produced (its SLAM
+// poses and map, its states) — and scores it into a Score: the rubric's lines and points, the final
+// pose errors, the map's quality, the Warehouse's stops and levels. Events: speed_run and
+// maze_explorer (SLAM from the start pose: the map frame is the start frame), warehouse
+// (localization in the given map: the map frame is the world frame; deliveries judged from the true
+// pose against mission/warehouse_rules.hpp). Times are microseconds on the simulation's clock.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mbot/mapping/occupancy_grid.hpp"
+#include "mbot/mapping/slam.hpp"
+#include "mbot/mission/mission_state.hpp"
+#include "mbot/mission/warehouse_rules.hpp"
+#include "mbot/motion/pose2d.hpp"
+#include "mbot/sim/world.hpp"
+
+namespace mbot::sim {
+
+enum class CompetitionEvent { kSpeedRun, kMazeExplorer, kWarehouse };
+const char* ToString(CompetitionEvent event);  // "speed_run", "maze_explorer", "warehouse"
+const char* Title(CompetitionEvent event);     // "Speed Run" …
+
+struct RefereeOptions {
+  CompetitionEvent event = CompetitionEvent::kSpeedRun;
+  double time_limit_s = 180.0;   // the run ends here if the mission has not
+  double finish_delay_s = 0.5;   // keep simulating this long after the mission ends (the robot stops)
+};
+
+// One line of the rubric: what was judged, how it went, the points.
+struct RubricItem {
+  std::string name, detail;
+  int points = 0, max = 100;
+};
+
+struct PoseError {
+  double x_m = 0, y_m = 0, theta_deg = 0;  // absolute errors per axis
+};
+
+struct MapQuality {
+  double coverage = 0;   // share of the reachable free space (≥ one SLAM cell from walls) mapped free
+  double precision = 0;  // share of the mapped walls within 1.5 SLAM cells of a true wall
+  int reachable_cells = 0, occupied_cells = 0;
+};
+
+struct StopResult {
+  mission::warehouse::Stop stop;
+  std::optional<double> done_at_s;  // since the start of the event
+  bool missed = false;              // the robot stood at a later stop first
+};
+
+struct Score {
+  CompetitionEvent event = CompetitionEvent::kSpeedRun;
+  mission::MissionState state = mission::MissionState::kInitializing;
+  std::string detail;
+  bool scored = false;     // false without ground truth (nothing to judge)
+  bool completed = false;  // the mission said completed
+  bool timed_out = false;
+  double time_s = 0;       // to the mission's end, or the whole run
+  double sim_s = 0;        // simulated time seen
+  int collisions = 0;
+  motion::Pose2D start, final_pose;  // true, world frame
+  motion::Pose2D map_frame;          // where the map frame lies in the world
+  std::optional<PoseError> final_error;       // final pose against the start (not the Warehouse)
+  std::optional<PoseError> slam_final_error;  // SLAM's last pose against the truth then
+  std::optional<MapQuality> map;              // not the Warehouse
+  std::optional<double> localized_at_s;       // the Warehouse: when global localization settled
+  int levels_reached = 0;
+  std::vector<StopResult> stops;
+  std::vector<RubricItem> items;
+  int total = 0, max_total = 0;
+};
+
+// Points for a final pose error, the rubric's tiers (< 3 cm / 3 cm / 15° → 100, 5/5/15 → 75,
+// 10/10/30 → 50, 20/20/45 → 25).
+int PosePoints(const PoseError& e);
+// Lap time tiers: < 15 s → 100, < 20 s → 75, < 30 s → 50.
+int LapPoints(double seconds);
+// The map (in the frame of `start`) against the world: coverage of the reachable free space and
+// precision of the walls.
+MapQuality Quality(const World& world, const mapping::OccupancyGrid& map, const motion::Pose2D& start);
+
+class Referee {
+ public:
+  // Throws std::invalid_argument for a Warehouse in a world without its targets and drop-offs.
+  Referee(const RefereeOptions& options, World world, uint64_t seed);
+
+  // Called first for every event of the stream, with its time.
+  void Tick(int64_t t_us);
+  void OnTruePose(int64_t t_us, const motion::Pose2D& pose);
+  void OnCollision() { ++collisions_; }
+  void OnSlamPose(int64_t t_us, const motion::Pose2D& pose) { slam_.push_back({t_us, pose}); }
+  void OnMap(std::shared_ptr<const mapping::OccupancyGrid> map) { map_ = std::move(map); }
+  void OnSlamState(int64_t t_us, mapping::SlamState state);
+  void OnMissionStatus(int64_t t_us, const mission::MissionStatus& status);
+  // Why the run should end now — the mission ended finish_delay_s ago, or the time limit — once;
+  // nullopt otherwise.
+  std::optional<std::string> StopReason(int64_t t_us);
+
+  Score Judge() const;
+
+  const World& world() const { return world_; }
+  const std::vector<motion::TimedPose>& truth() const { return truth_; }
+  const std::vector<motion::TimedPose>& slam() const { return slam_; }
+  const std::shared_ptr<const mapping::OccupancyGrid>& map() const { return map_; }
+  const std::vector<mission::warehouse::Stop>& stops() const { return stops_; }
+
+ private:
+  void JudgeStop(const motion::TimedPose& truth);
+
+  RefereeOptions o_;
+  World world_;
+  int64_t t0_us_ = -1, last_us_ = 0, end_us_ = -1, localized_us_ = -1;
+  std::vector<motion::TimedPose> truth_, slam_;
+  std::shared_ptr<const mapping::OccupancyGrid> map_;
+  mission::MissionState state_ = mission::MissionState::kInitializing;
+  std::string detail_;
+  int collisions_ = 0;
+  bool stop_sent_ = false, timed_out_ = false;
+  // Warehouse.
+  std::vector<mission::warehouse::Stop> stops_;
+  std::vector<int64_t> stop_done_us_;  // per judged stop, in order: when it was done, -1 missed
+  int near_stop_ = -1;                 // the stop the robot stands at, since near_since_us_
+  bool left_last_stop_ = true;         // the robot has moved off the last stop done
+  int64_t near_since_us_ = -1;
+};
+
+}  // namespace mbot::sim
