@@ -99,8 +99,9 @@ class OdometryStage : public Stage {
         << ", \"gyro_bias_rad_s\": " << Num(v.odometry.gyro_bias_rad_s());
       drivers::MapOverlay path{{}, colours[k % 4][0], colours[k % 4][1], colours[k % 4][2], false, v.name};
       if (!est.empty()) {
-        const motion::AteResult aligned = motion::ComputeAte(est, truth, motion::AteAlignment::kBestFitSE2);
-        const motion::AteResult anchored = motion::ComputeAte(est, truth, motion::AteAlignment::kFirstPose);
+        const motion::TrajectoryErrors errors = motion::EvaluateTrajectory(est, truth);
+        const motion::AteResult& aligned = errors.aligned;
+        const motion::AteResult& anchored = errors.anchored;
         j << ", \"aligned\": " << AteJson(aligned) << ", \"anchored\": " << AteJson(anchored);
         mbot::log::Info("odometry: " + v.name + ": aligned xy RMSE " + Num(aligned.xy.rmse, 3) + " m, theta RMSE " +
                         Num(aligned.theta.rmse * 180 / M_PI, 3) + " deg; anchored final heading error " +

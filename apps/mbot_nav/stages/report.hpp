@@ -93,6 +93,12 @@ inline std::string AteJson(const motion::AteResult& a) {
          ", \"theta_deg\": " + Num(a.final_error.theta * 180.0 / M_PI) + "}, \"alignment\": " + PoseJson(a.alignment) + "}";
 }
 
+// {"aligned": …, "anchored": …, "unaligned": …}: an estimate's errors under each convention.
+inline std::string TrajectoryErrorsJson(const motion::TrajectoryErrors& e) {
+  return "{\"aligned\": " + AteJson(e.aligned) + ",\n    \"anchored\": " + AteJson(e.anchored) +
+         ",\n    \"unaligned\": " + AteJson(e.unaligned) + "}";
+}
+
 // A TUM trajectory file (written whole or not at all): a comment line naming what it holds, then
 // one line per pose, each composed onto `frame` (the identity: as given).
 inline void WriteTum(const std::string& path, const std::string& what, const std::vector<motion::TimedPose>& poses,

@@ -73,8 +73,12 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
   o.time_base = s.GetChoice("time_base", "event", {"event", "stamp", "auto"},
                             "place messages at their arrival (event) times, as the log's motion capture is, or at "
                             "their own stamps (auto: where a channel's stamps share the log's clock)");
-  o.beam_timing = s.GetChoice("beam_timing", "auto", {"auto", "beams", "spread", "none"},
-                              "per-beam time: the beams' own times, spread evenly over the time since the last scan, "
+  o.beam_timing = s.GetEnum("beam_timing", o.beam_timing,
+                            {{"auto", mapping::BeamTiming::kAuto},
+                             {"beams", mapping::BeamTiming::kBeams},
+                             {"spread", mapping::BeamTiming::kSpread},
+                             {"none", mapping::BeamTiming::kNone}},
+                            "per-beam time: the beams' own times, spread evenly over the time since the last scan, "
                               "or none (all at the scan time); auto picks the first that applies");
   o.lidar_time_offset_us = static_cast<int64_t>(
       std::llround(s.GetDouble("lidar_time_offset_s", 0.0, "added to a scan's time (its last beam) before poses are looked up", -1.0, 1.0) * 1e6));
@@ -165,10 +169,11 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
   o.initial_sigma_theta = s.GetDouble("initial_sigma_theta_rad", 0.0, "heading spread of the first particles", 0.0);
 
   // Perturbations.
-  o.noise_trans = s.GetDouble("odometry_noise_trans", 0.0, "injected odometry noise: sigma per metre of each step", 0.0);
-  o.noise_rot = s.GetDouble("odometry_noise_rot", 0.0, "injected heading noise: sigma per radian and metre of each step", 0.0);
-  o.kidnap_at_s = s.GetDouble("kidnap_at_s", -1.0, "from this time on, odometry is offset by kidnap_offset (< 0: never)");
-  o.kidnap_offset = ParsePose(s, "kidnap_offset", {1.0, 0.0, M_PI / 2}, "the kidnapping jump");
+  auto& pert = o.perturbation;
+  pert.noise_trans = s.GetDouble("odometry_noise_trans", 0.0, "injected odometry noise: sigma per metre of each step", 0.0);
+  pert.noise_rot = s.GetDouble("odometry_noise_rot", 0.0, "injected heading noise: sigma per radian and metre of each step", 0.0);
+  pert.kidnap_at_s = s.GetDouble("kidnap_at_s", -1.0, "from this time on, odometry is offset by kidnap_offset (< 0: never)");
+  pert.kidnap_offset = ParsePose(s, "kidnap_offset", {1.0, 0.0, M_PI / 2}, "the kidnapping jump");
 
   // Outputs.
   o.score_from_us = static_cast<int64_t>(s.GetDouble("score_from_s", 0.0, "ATE counts scans from this long after the start", 0.0) * 1e6);

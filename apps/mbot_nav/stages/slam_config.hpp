@@ -6,6 +6,8 @@
 #include <string>
 
 #include "mbot/mapping/slam.hpp"
+#include "mbot/mapping/moving_scan.hpp"
+#include "mbot/motion/odometry_perturbation.hpp"
 #include "mbot/motion/wheel_odometry.hpp"
 
 namespace mbot::config {
@@ -27,7 +29,7 @@ struct SlamStageOptions {
   bool lidar_pose_from_scan = true;     // the sensor pose the source gives (rawlog, CARMEN), else lidar_pose
   motion::Pose2D lidar_pose;
   std::string time_base = "event";      // event | stamp | auto
-  std::string beam_timing = "auto";     // auto | beams | spread | none
+  mapping::BeamTiming beam_timing = mapping::BeamTiming::kAuto;
   int64_t lidar_time_offset_us = 0;
   double max_pose_gap_s = 0.5;
   // Start.
@@ -35,9 +37,7 @@ struct SlamStageOptions {
   motion::Pose2D initial_pose;
   double initial_sigma_xy = 0.0, initial_sigma_theta = 0.0;
   // Perturbations for robustness tests.
-  double noise_trans = 0.0, noise_rot = 0.0;
-  double kidnap_at_s = -1.0;
-  motion::Pose2D kidnap_offset;
+  motion::OdometryPerturbationOptions perturbation;
   // Outputs.
   int64_t score_from_us = 0;            // ATE counts scans from this long after the start
   int64_t score_max_latency_us = 0;     // ... that arrived at most this late (0: all)

@@ -44,4 +44,40 @@ std::vector<ScanRay> DeskewScan(const std::vector<float>& ranges, const std::vec
   return rays;
 }
 
+namespace {
+
+// The beams' angles sweep more than 1.5π: a full revolution of a spinning lidar.
+bool CoversTurn(const std::vector<float>& angles) {
+  if (angles.size() < 3) return false;
+  double turned = 0;
+  for (size_t i = 1; i < angles.size(); ++i) turned += std::abs(motion::WrapAngle(angles[i] - angles[i - 1]));
+  return turned > 1.5 * M_PI;
+}
+
+}  // namespace
+
+BeamTimes TimeBeams(BeamTiming timing, const std::vector<float>& angles, const std::vector<int64_t>& beam_times,
+                    int64_t period) {
+  BeamTimes out;
+  const size_t n = angles.size();
+  const bool beams_usable = beam_times.size() == n && n > 1 && period > 0 && beam_times.back() - beam_times.front() > period / 2;
+  if (timing == BeamTiming::kBeams || (timing == BeamTiming::kAuto && beams_usable)) {
+    if (!beams_usable) {
+      out.beam_times_unusable = true;
+      return out;
+    }
+    out.duration_us = beam_times.back() - beam_times.front();
+    out.fractions.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+      out.fractions[i] = static_cast<float>(double(beam_times[i] - beam_times.front()) / out.duration_us);
+    }
+  } else if (timing == BeamTiming::kSpread ||
+             (timing == BeamTiming::kAuto && period > 0 && period < 1'000'000 && CoversTurn(angles))) {
+    out.duration_us = period > 0 && period < 1'000'000 ? period : 0;
+    out.fractions.resize(n);
+    for (size_t i = 0; i < n; ++i) out.fractions[i] = n > 1 ? float(double(i) / (n - 1)) : 1.0f;
+  }
+  return out;
+}
+
 }  // namespace mbot::mapping

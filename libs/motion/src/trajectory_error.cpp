@@ -79,4 +79,9 @@ AteResult ComputeAte(const std::vector<Pose2D>& est, const std::vector<Pose2D>& 
   return r;
 }
 
+TrajectoryErrors EvaluateTrajectory(const std::vector<Pose2D>& estimate, const std::vector<Pose2D>& truth) {
+  return {ComputeAte(estimate, truth, AteAlignment::kBestFitSE2), ComputeAte(estimate, truth, AteAlignment::kFirstPose),
+          ComputeAte(estimate, truth, AteAlignment::kNone)};
+}
+
 }  // namespace mbot::motion

@@ -3,6 +3,7 @@
 // scan's start and end, so a particle only has to apply one rigid transform to every ray.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "mbot/motion/pose2d.hpp"
@@ -29,5 +30,22 @@ std::vector<ScanRay> DeskewScan(const std::vector<float>& ranges, const std::vec
                                 const std::vector<float>& fractions, const motion::Pose2D& start_in_end,
                                 const motion::Pose2D& sensor, double sensor_max_range_m,
                                 const ScanOptions& options);
+
+// When each beam of a scan was measured. kBeams: the scan's own per-beam times; kSpread: beams evenly
+// over the time since the previous scan (a spinning lidar without usable beam times); kNone: all at
+// the scan's time (no deskew); kAuto: beam times when they span at least half the scan period, else
+// spread when the scan covers a turn and the period is under a second, else none.
+enum class BeamTiming { kAuto, kBeams, kSpread, kNone };
+
+struct BeamTimes {
+  std::vector<float> fractions;  // per beam, 0 = the scan's start, 1 = its end; empty: no deskew
+  int64_t duration_us = 0;       // from the scan's start to its end
+  bool beam_times_unusable = false;  // kBeams was asked for, but the beam times do not span the scan
+};
+
+// `period_us`: the time since the previous scan (0 when unknown); `beam_times_us` empty when the
+// source gives none.
+BeamTimes TimeBeams(BeamTiming timing, const std::vector<float>& angles_rad, const std::vector<int64_t>& beam_times_us,
+                    int64_t period_us);
 
 }  // namespace mbot::mapping

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "mbot/mapping/action_model.hpp"
@@ -46,6 +47,37 @@ struct SlamStep {
   motion::Pose2D pose;
   bool filter_updated = false;  // the particle filter ran on this scan
   FilterStatus status;          // the filter's state after this scan (when it has one)
+};
+
+// What happened to the filter over a run, scan by scan: when global localization converged, when
+// the filter flagged the robot lost (a kidnapping) and when it recovered (converged again with
+// the scan explaining at least `recovered_inlier_fraction` of its returns).
+class SlamEventTracker {
+ public:
+  struct Lost {
+    double at_s = 0;
+    int at_scan = 0;
+    double recovered_at_s = -1;  // -1: not (yet)
+    int recovered_at_scan = -1;
+  };
+  explicit SlamEventTracker(double recovered_inlier_fraction) : recovered_inlier_fraction_(recovered_inlier_fraction) {}
+  // Global localization started (its convergence is then tracked).
+  void GlobalStarted() { global_ = true; }
+  // One processed scan (0-based index) at `t_s` since the start; `updated`: the filter ran on it.
+  // Returns a line worth logging when something happened, else "".
+  std::string Add(double t_s, int scan, bool updated, const FilterStatus& status);
+
+  bool global() const { return global_; }
+  double converged_at_s() const { return converged_at_s_; }  // -1: not converged
+  int converged_at_scan() const { return converged_scan_; }
+  const std::vector<Lost>& lost() const { return lost_; }
+
+ private:
+  double recovered_inlier_fraction_;
+  bool global_ = false;
+  double converged_at_s_ = -1;
+  int converged_scan_ = -1;
+  std::vector<Lost> lost_;
 };
 
 class Slam {

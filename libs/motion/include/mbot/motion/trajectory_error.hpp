@@ -30,4 +30,10 @@ Pose2D BestFitSE2(const std::vector<Pose2D>& estimate, const std::vector<Pose2D>
 // `estimate` and `truth` are paired by index; both must have the same size (≥ 1).
 AteResult ComputeAte(const std::vector<Pose2D>& estimate, const std::vector<Pose2D>& truth, AteAlignment alignment);
 
+// An estimate scored against the truth under each convention at once.
+struct TrajectoryErrors {
+  AteResult aligned, anchored, unaligned;
+};
+TrajectoryErrors EvaluateTrajectory(const std::vector<Pose2D>& estimate, const std::vector<Pose2D>& truth);
+
 }  // namespace mbot::motion

@@ -1,0 +1,155 @@
+#include "slam_outputs.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "mbot/common/atomic_file.hpp"
+#include "mbot/common/log.hpp"
+#include "mbot/drivers/map_io.hpp"
+#include "mbot/motion/trajectory_error.hpp"
+#include "report.hpp"
+
+namespace mbot::app {
+namespace {
+
+using motion::Pose2D;
+using motion::TimedPose;
+
+std::vector<Pose2D> PosesOf(const std::vector<TimedPose>& s) {
+  std::vector<Pose2D> v;
+  for (const TimedPose& p : s) v.push_back(p.pose);
+  return v;
+}
+
+void WriteScansCsv(const std::string& path, const std::vector<ScanRecord>& records) {
+  WriteFileAtomically(path, [&](std::ostream& o) {
+    o << "t_s,x,y,theta,filter_updated,particles,ess,spread_m,inlier_fraction,fit_ratio,injected,lost,converged,update_ms\n";
+    char line[256];
+    for (const ScanRecord& r : records) {
+      std::snprintf(line, sizeof line, "%.6f,%.4f,%.4f,%.5f,%d,%d,%.1f,%.4f,%.3f,%.3f,%d,%d,%d,%.3f\n", r.t_us * 1e-6, r.slam.x,
+                    r.slam.y, r.slam.theta, r.updated, r.status.particles, r.status.ess, r.status.spread_m,
+                    r.status.inlier_fraction, r.status.fit_ratio, r.status.injected, r.status.lost, r.status.converged, r.update_ms);
+      o << line;
+    }
+  });
+}
+
+}  // namespace
+
+void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& run) {
+  const SlamStageOptions& options = *run.options;
+  const std::vector<ScanRecord>& records = *run.records;
+  const std::string dir = ctx.output_dir + "/";
+  const int64_t max_gap = static_cast<int64_t>(options.max_pose_gap_s * 1e6);
+  const std::vector<TimedPose>& truth_series = options.truth_is_reference ? *run.reference : *run.ground_truth;
+  const std::string truth_name = options.truth_is_reference ? "reference" : "ground truth";
+
+  // Each scan's pose against the truth at its time: within the scoring window and not too late.
+  std::vector<TimedPose> slam_path, odometry_path, truth_path;
+  int unscored_late = 0;
+  std::vector<Pose2D> est_paired, odo_paired, truth_paired, ref_paired, ref_truth_paired;
+  for (const ScanRecord& r : records) {
+    slam_path.push_back({r.t_us, r.slam});
+    odometry_path.push_back({r.t_us, r.odometry});
+    Pose2D t;
+    if (!motion::InterpolateAt(truth_series, r.t_us, max_gap, &t)) continue;
+    truth_path.push_back({r.t_us, t});
+    const bool late = options.score_max_latency_us > 0 && r.latency_us > options.score_max_latency_us;
+    unscored_late += late;
+    if (r.t_us < options.score_from_us + run.first_t_us || late) continue;
+    est_paired.push_back(r.slam);
+    odo_paired.push_back(r.odometry);
+    truth_paired.push_back(t);
+    Pose2D ref;
+    if (!options.truth_is_reference && motion::InterpolateAt(*run.reference, r.t_us, max_gap, &ref)) {
+      ref_paired.push_back(ref);
+      ref_truth_paired.push_back(t);
+    }
+  }
+  WriteTum(dir + "slam.tum", std::string("SLAM (") + mapping::ToString(options.slam.mode) + ")", slam_path);
+  WriteTum(dir + "odometry.tum", "odometry at the scan times", odometry_path);
+  WriteScansCsv(dir + "slam_scans.csv", records);
+  if (!truth_path.empty()) WriteTum(dir + "ground_truth.tum", truth_name + " at the scan times", truth_path);
+
+  const mapping::OccupancyGrid& map = run.slam->map();
+  const std::string base = dir + options.map_basename;
+  if (options.slam.mode != mapping::SlamMode::kLocalization) {
+    drivers::WriteBotlabMap(map, base + ".map");
+    drivers::WriteRosMap(map, base + ".yaml");
+    if (options.octomap_height_m > 0) drivers::WriteOctomap(map, options.octomap_height_m, base + ".bt");
+  }
+  std::vector<drivers::MapOverlay> overlays;
+  if (!run.particle_snapshots->empty()) overlays.push_back({*run.particle_snapshots, 255, 160, 0, true, "particles"});
+  if (!truth_path.empty()) overlays.push_back({PosesOf(truth_path), 0, 170, 0, false, truth_name});
+  overlays.push_back({PosesOf(odometry_path), 220, 0, 0, false, "odometry"});
+  overlays.push_back({PosesOf(slam_path), 0, 60, 255, false, "SLAM"});
+  drivers::WriteMapPngWithOverlays(map, overlays, options.png_scale, base + ".png");
+
+  // Map sharpness: the share of every scan's returns that end within inlier_distance_m of an
+  // obstacle of the final map, at the pose the scan was given (blurred or doubled walls lower it).
+  double consistency = NAN;
+  if (!run.scan_points->empty()) {
+    mapping::SensorModel model(options.slam.sensor);
+    model.SetMap(map);
+    double sum = 0;
+    for (size_t i = 0; i < run.scan_points->size(); ++i) sum += model.InlierFraction(records[i].slam, (*run.scan_points)[i]);
+    consistency = sum / run.scan_points->size();
+  }
+  std::vector<double> update_ms, filter_ms, ess;
+  int updates = 0;
+  for (const ScanRecord& r : records) {
+    update_ms.push_back(r.update_ms);
+    if (r.updated) ++updates, filter_ms.push_back(r.update_ms), ess.push_back(r.status.ess);
+  }
+  const double data_s = (run.last_t_us - run.first_t_us) * 1e-6;
+  std::ostringstream j;
+  j << "{\n  \"mode\": " << JsonString(mapping::ToString(options.slam.mode)) << ",\n  \"seed\": " << ctx.seed
+    << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"source\": " << JsonString(ctx.source_path)
+    << ",\n  \"scans\": " << records.size() << ",\n  \"scans_skipped\": " << run.skipped_scans << ",\n  \"filter_updates\": " << updates
+    << ",\n  \"particles\": " << options.slam.filter.particles
+    << ",\n  \"truth\": " << JsonString(truth_series.empty() ? "none" : truth_name) << ",\n  \"scans_not_scored_late\": " << unscored_late;
+  if (!est_paired.empty()) {
+    const motion::TrajectoryErrors slam_errors = motion::EvaluateTrajectory(est_paired, truth_paired);
+    const motion::TrajectoryErrors odo_errors = motion::EvaluateTrajectory(odo_paired, truth_paired);
+    j << ",\n  \"slam_ate\": " << TrajectoryErrorsJson(slam_errors) << ",\n  \"odometry_ate\": " << TrajectoryErrorsJson(odo_errors);
+    if (!ref_paired.empty()) j << ",\n  \"reference_ate\": " << TrajectoryErrorsJson(motion::EvaluateTrajectory(ref_paired, ref_truth_paired));
+    const motion::AteResult& a = slam_errors.aligned;
+    const motion::AteResult& o = odo_errors.aligned;
+    mbot::log::Info("slam: ATE vs " + truth_name + " (aligned, " + std::to_string(a.samples) + " scans): RMSE x " + Num(a.x.rmse, 3) +
+                    " m, y " + Num(a.y.rmse, 3) + " m, xy " + Num(a.xy.rmse, 3) + " m, theta " + Num(a.theta.rmse * 180 / M_PI, 3) +
+                    " deg; odometry xy " + Num(o.xy.rmse, 3) + " m, theta " + Num(o.theta.rmse * 180 / M_PI, 3) + " deg");
+  }
+  const mapping::SlamEventTracker& ev = *run.events;
+  j << ",\n  \"global_localization\": ";
+  if (!ev.global()) {
+    j << "null";
+  } else {
+    j << "{\"converged\": " << (ev.converged_at_s() >= 0 ? "true" : "false") << ", \"converged_at_s\": " << Num(ev.converged_at_s())
+      << ", \"converged_at_scan\": " << ev.converged_at_scan() << "}";
+  }
+  j << ",\n  \"kidnapping\": "
+    << (run.kidnapped_at_us < 0 ? std::string("null") : "{\"at_s\": " + Num((run.kidnapped_at_us - run.first_t_us) * 1e-6) + "}");
+  j << ",\n  \"lost\": [";
+  for (size_t i = 0; i < ev.lost().size(); ++i) {
+    const mapping::SlamEventTracker::Lost& l = ev.lost()[i];
+    const bool recovered = l.recovered_at_scan >= 0;
+    j << (i ? ", " : "") << "{\"at_s\": " << Num(l.at_s) << ", \"at_scan\": " << l.at_scan
+      << ", \"recovered_at_s\": " << (recovered ? Num(l.recovered_at_s) : "null")
+      << ", \"scans_to_recover\": " << (recovered ? std::to_string(l.recovered_at_scan - l.at_scan) : "null") << "}";
+  }
+  j << "]";
+  j << ",\n  \"effective_sample_size\": " << SampleStats::Of(ess).Json()
+    << ",\n  \"timing\": {\"scan_update_ms\": " << SampleStats::Of(update_ms).Json()
+    << ", \"filter_update_ms\": " << SampleStats::Of(filter_ms).Json() << ", \"wall_s\": " << Num(run.wall_s)
+    << ", \"data_s\": " << Num(data_s) << ", \"real_time_factor\": " << Num(run.wall_s > 0 ? data_s / run.wall_s : NAN) << "}"
+    << ",\n  \"map\": {\"scan_consistency\": " << Num(consistency) << ", \"width\": " << map.width() << ", \"height\": " << map.height()
+    << ", \"resolution\": " << Num(map.resolution()) << ", \"origin_x\": " << Num(map.origin_x())
+    << ", \"origin_y\": " << Num(map.origin_y()) << "}\n}\n";
+  WriteFileAtomically(dir + "metrics.json", [&](std::ostream& o) { o << j.str(); });
+  mbot::log::Info("slam: " + std::to_string(records.size()) + " scans (" + std::to_string(updates) + " filter updates), scan consistency " +
+                  Num(consistency, 3) + ", median " + Num(SampleStats::Of(update_ms).median, 3) + " ms per scan; outputs in " +
+                  ctx.output_dir);
+}
+
+}  // namespace mbot::app

@@ -1,0 +1,71 @@
+// Beam timing (mapping::TimeBeams) and the SLAM event tracker, on tiny inputs.
+#include "mbot/mapping/moving_scan.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "mbot/mapping/slam.hpp"
+
+namespace mbot::mapping {
+namespace {
+
+std::vector<float> Revolution(int n) {
+  std::vector<float> a(n);
+  for (int i = 0; i < n; ++i) a[i] = static_cast<float>(2 * M_PI * i / n);
+  return a;
+}
+
+TEST(TimeBeams, UsesTheBeamsOwnTimesWhenTheySpanTheScan) {
+  const std::vector<float> angles = Revolution(5);
+  const std::vector<int64_t> times = {1000, 26000, 51000, 76000, 101000};
+  const BeamTimes b = TimeBeams(BeamTiming::kAuto, angles, times, 125000);
+  EXPECT_EQ(b.duration_us, 100000);
+  ASSERT_EQ(b.fractions.size(), 5u);
+  EXPECT_FLOAT_EQ(b.fractions[0], 0.0f);
+  EXPECT_FLOAT_EQ(b.fractions[2], 0.5f);
+  EXPECT_FLOAT_EQ(b.fractions[4], 1.0f);
+}
+
+TEST(TimeBeams, SpreadsARevolutionWithoutBeamTimesOverThePeriod) {
+  const BeamTimes b = TimeBeams(BeamTiming::kAuto, Revolution(8), {}, 125000);
+  EXPECT_EQ(b.duration_us, 125000);
+  ASSERT_EQ(b.fractions.size(), 8u);
+  EXPECT_FLOAT_EQ(b.fractions[7], 1.0f);
+  // A partial sweep (not a turn) or an unknown period: no deskew.
+  EXPECT_TRUE(TimeBeams(BeamTiming::kAuto, {0.0f, 0.1f, 0.2f}, {}, 125000).fractions.empty());
+  EXPECT_TRUE(TimeBeams(BeamTiming::kAuto, Revolution(8), {}, 0).fractions.empty());
+  EXPECT_TRUE(TimeBeams(BeamTiming::kNone, Revolution(8), {}, 125000).fractions.empty());
+}
+
+TEST(TimeBeams, AskedForBeamTimesThatDoNotSpanTheScanSaysSo) {
+  const BeamTimes b = TimeBeams(BeamTiming::kBeams, Revolution(3), {0, 1, 2}, 125000);
+  EXPECT_TRUE(b.beam_times_unusable);
+  EXPECT_TRUE(b.fractions.empty());
+}
+
+TEST(SlamEventTracker, ConvergenceLostAndRecovered) {
+  SlamEventTracker t(0.6);
+  t.GlobalStarted();
+  FilterStatus s;
+  s.converged = false;
+  EXPECT_EQ(t.Add(0.1, 0, true, s), "");
+  s.converged = true;
+  s.inlier_fraction = 0.9;
+  EXPECT_NE(t.Add(0.2, 1, true, s).find("converged after 2 scans"), std::string::npos);
+  s.lost = true;
+  s.inlier_fraction = 0.2;
+  EXPECT_NE(t.Add(5.0, 40, true, s).find("lost at 5 s"), std::string::npos);
+  EXPECT_EQ(t.Add(5.1, 41, true, s), "");  // still lost: one episode
+  s.lost = false;
+  s.inlier_fraction = 0.5;  // converged, but the scan does not fit yet
+  EXPECT_EQ(t.Add(5.2, 42, true, s), "");
+  s.inlier_fraction = 0.8;
+  EXPECT_NE(t.Add(5.3, 43, true, s).find("recovered"), std::string::npos);
+  EXPECT_DOUBLE_EQ(t.converged_at_s(), 0.2);
+  ASSERT_EQ(t.lost().size(), 1u);
+  EXPECT_EQ(t.lost()[0].recovered_at_scan - t.lost()[0].at_scan, 3);
+}
+
+}  // namespace
+}  // namespace mbot::mapping
