@@ -75,7 +75,8 @@ CompetitionPlan BuildCompetition(const config::Config& config) {
   c.Finish();
   {
     config::Section o = config.GetSection("output");
-    plan.output_dir = o.GetPath("dir", "out/competition", "each event writes to dir/<event>; the table to dir/competition.json");
+    plan.output_dir =
+        o.GetPath("dir", "out/competition", "each event writes to dir/<event>; the table to dir/competition.json");
     o.Finish();
   }
   std::set<std::string> used = {"competition", "output"};
@@ -94,9 +95,11 @@ CompetitionPlan BuildCompetition(const config::Config& config) {
   for (const std::string& name : events) {
     config::Section e = config.GetSection(name);
     const std::string path = e.RequirePath("config", "the event's own configuration (an INI a single run takes)");
-    const std::string world = e.GetPath("world", "", "another world for the event (its [source] path: an arena or a map)");
+    const std::string world =
+        e.GetPath("world", "", "another world for the event (its [source] path: an arena or a map)");
     const long long event_seed = e.GetInt("seed", seed, "this event's seed", 0);
-    const std::string set_text = e.GetString("set", "", "section.key=value overrides of the event's configuration, separated by ';'");
+    const std::string set_text =
+        e.GetString("set", "", "section.key=value overrides of the event's configuration, separated by ';'");
     e.Finish();
     std::vector<std::string> sets;
     for (size_t b = 0; b <= set_text.size();) {
@@ -173,8 +176,10 @@ int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
   bool incomplete = false;  // an event that should have scored did not
   std::ostringstream t;
   t << "\nCompetition on the simulator (Winter 2024 rules)\n"
-    << std::left << std::setw(15) << "event" << std::setw(22) << "arena" << std::setw(6) << "seed" << std::setw(12) << "result"
-    << std::right << std::setw(8) << "time s" << std::setw(11) << "points" << std::setw(6) << "hits" << std::setw(7) << "RTF" << "\n";
+    << std::left << std::setw(15) << "event" << std::setw(22) << "arena" << std::setw(6) << "seed" << std::setw(12)
+    << "result" << std::right << std::setw(8) << "time s" << std::setw(11) << "points" << std::setw(6) << "hits"
+    << std::setw(7) << "RTF"
+    << "\n";
   for (const Row& r : rows) {
     if (r.points.empty()) {
       incomplete = true;
@@ -182,16 +187,17 @@ int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
       continue;
     }
     total += std::stoi(r.points), max_total += std::stoi(r.max_points);
-    t << std::left << std::setw(15) << r.event << std::setw(22) << r.arena.substr(0, 21) << std::setw(6) << r.seed << std::setw(12)
-      << r.result.substr(0, 11) << std::right << std::setw(8) << r.time_s << std::setw(11) << (r.points + " / " + r.max_points)
-      << std::setw(6) << r.collisions << std::setw(6) << r.rtf << "x\n";
+    t << std::left << std::setw(15) << r.event << std::setw(22) << r.arena.substr(0, 21) << std::setw(6) << r.seed
+      << std::setw(12) << r.result.substr(0, 11) << std::right << std::setw(8) << r.time_s << std::setw(11)
+      << (r.points + " / " + r.max_points) << std::setw(6) << r.collisions << std::setw(6) << r.rtf << "x\n";
   }
   for (const std::string& n : plan.not_run) {
     const auto colon = n.find(':');
     t << std::left << std::setw(15) << n.substr(0, colon) << "not run"
       << (colon == std::string::npos ? "" : ":" + n.substr(colon + 1)) << "\n";
   }
-  t << std::left << std::setw(63) << "total" << std::right << std::setw(11) << (std::to_string(total) + " / " + std::to_string(max_total))
+  t << std::left << std::setw(63) << "total" << std::right << std::setw(11)
+    << (std::to_string(total) + " / " + std::to_string(max_total))
     << (incomplete ? "  (incomplete: an event above has no score)" : "") << "\n";
   std::cout << t.str() << std::flush;
 
@@ -201,8 +207,9 @@ int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
     const Row& r = rows[i];
     auto num = [](const std::string& v) { return v.empty() ? std::string("null") : v; };
     j << (i ? "," : "") << "\n    {\"section\": " << JsonString(r.name) << ", \"event\": " << JsonString(r.event)
-      << ", \"arena\": " << JsonString(r.arena) << ", \"seed\": " << num(r.seed) << ", \"result\": " << JsonString(r.result)
-      << ", \"time_s\": " << num(r.time_s) << ", \"points\": " << num(r.points) << ", \"max_points\": " << num(r.max_points)
+      << ", \"arena\": " << JsonString(r.arena) << ", \"seed\": " << num(r.seed)
+      << ", \"result\": " << JsonString(r.result) << ", \"time_s\": " << num(r.time_s)
+      << ", \"points\": " << num(r.points) << ", \"max_points\": " << num(r.max_points)
       << ", \"collisions\": " << num(r.collisions) << ", \"real_time_factor\": " << num(r.rtf)
       << ", \"outputs\": " << JsonString(r.outputs) << "}";
   }

@@ -42,8 +42,9 @@ void ListStages() {
   auto describe = [](const std::string& title, const std::string& doc, mbot::config::Section& s) {
     std::cout << title << "\n    " << doc << "\n";
     for (const auto& k : s.docs()) {
-      std::cout << "    " << k.key << " (" << k.type << ") = "
-                << (k.required ? std::string("<required>") : k.default_value) << "\n        " << k.doc << "\n";
+      std::cout << "    " << k.key << " (" << k.type
+                << ") = " << (k.required ? std::string("<required>") : k.default_value) << "\n        " << k.doc
+                << "\n";
     }
     std::cout << "\n";
   };
@@ -139,13 +140,17 @@ int main(int argc, char** argv) {
   std::signal(SIGTERM, OnSignal);
   if (competition) {
     const int status = mbot::app::RunCompetition(*competition, g_stop);
-    std::fprintf(stderr, "%s: %d warnings; outputs in %s\n", status == 130 ? "interrupted" : status ? "failed" : "done",
+    std::fprintf(stderr, "%s: %d warnings; outputs in %s\n",
+                 status == 130 ? "interrupted"
+                 : status      ? "failed"
+                               : "done",
                  mbot::log::WarningCount(), competition->output_dir.c_str());
     return status;
   }
   try {
     const auto summary = mbot::app::RunPlan(plan, g_stop);
-    std::fprintf(stderr, "%s: %lld events, %.1f s of data in %.2f s wall (%.0fx real time), %d warnings; outputs in %s\n",
+    std::fprintf(stderr,
+                 "%s: %lld events, %.1f s of data in %.2f s wall (%.0fx real time), %d warnings; outputs in %s\n",
                  summary.interrupted ? "interrupted" : "done", summary.events, summary.data_seconds,
                  summary.wall_seconds, summary.wall_seconds > 0 ? summary.data_seconds / summary.wall_seconds : 0.0,
                  mbot::log::WarningCount(), plan.output.dir.c_str());

@@ -15,8 +15,8 @@ namespace mbot::app {
 struct PipelineOptions {
   std::vector<std::string> stages;  // section names, in order
   uint64_t seed = 1;
-  std::string progress = "auto";    // auto, bar, lines, off
-  long long max_events = 0;         // 0: all
+  std::string progress = "auto";  // auto, bar, lines, off
+  long long max_events = 0;       // 0: all
 };
 
 struct OutputOptions {
@@ -40,7 +40,7 @@ struct RunSummary {
   double data_seconds = 0.0;
   double wall_seconds = 0.0;
   bool interrupted = false;
-  std::string stopped_by;  // the reason a stage gave when it ended the run, else ""
+  std::string stopped_by;                                    // the reason a stage gave when it ended the run, else ""
   std::vector<std::pair<std::string, std::string>> results;  // what stages reported (RunContext::results)
 };
 

@@ -32,8 +32,8 @@ class Bus {
 };
 
 struct RunContext {
-  std::string output_dir;     // exists when stages start
-  uint64_t seed = 0;          // the one seed all randomness derives from
+  std::string output_dir;  // exists when stages start
+  uint64_t seed = 0;       // the one seed all randomness derives from
   const drivers::Source* source = nullptr;
   std::string source_path;
   Bus* bus = nullptr;  // set by the pipeline; valid from Start to Finish

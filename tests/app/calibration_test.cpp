@@ -102,12 +102,14 @@ void WriteCalibrationLog(const std::string& path, double right_encoder_sign) {
 TEST(MotorCalibrationConfig, LcmLogWithPwmAndWheelSpeedsFitsWithin2Percent) {
   const std::string log = ::testing::TempDir() + "/calibration_run.log";
   WriteCalibrationLog(log, 1.0);
-  const std::string json = RunConfig("calibrate_motors.ini", "calib_lcm", {"source.path=" + log}, "motor_calibration.json");
+  const std::string json =
+      RunConfig("calibrate_motors.ini", "calib_lcm", {"source.path=" + log}, "motor_calibration.json");
   ASSERT_FALSE(json.empty());
   EXPECT_NE(json.find("\"samples_from\": \"PWM + measured wheel speeds\""), std::string::npos);
   EXPECT_NE(json.find("\"acceptable\": true"), std::string::npos) << json;
-  for (const auto& [wheel, dir, line] : {std::tuple{"left", "forward", kLeftFwd}, std::tuple{"left", "backward", kLeftBwd},
-                                         std::tuple{"right", "forward", kRightFwd}, std::tuple{"right", "backward", kRightBwd}}) {
+  for (const auto& [wheel, dir, line] :
+       {std::tuple{"left", "forward", kLeftFwd}, std::tuple{"left", "backward", kLeftBwd},
+        std::tuple{"right", "forward", kRightFwd}, std::tuple{"right", "backward", kRightBwd}}) {
     ExpectLine(json, wheel, dir, line, 0.02 * std::abs(line.punch));  // within 2 % on both
   }
 }
@@ -125,8 +127,9 @@ TEST(MotorCalibrationConfig, ReversedEncoderIsReportedAndNoSnippetIsWritten) {
   EXPECT_TRUE(std::filesystem::exists(out + "/motor_calibration.json"));
   EXPECT_FALSE(std::filesystem::exists(out + "/motor_calibration.ini"));
   // With the polarity set as the report advises, the same log is acceptable.
-  const std::string json = RunConfig("calibrate_motors.ini", "calib_fixed",
-                                     {"source.path=" + log, "calibration.right_encoder_polarity=-1"}, "motor_calibration.json");
+  const std::string json =
+      RunConfig("calibrate_motors.ini", "calib_fixed", {"source.path=" + log, "calibration.right_encoder_polarity=-1"},
+                "motor_calibration.json");
   EXPECT_NE(json.find("\"acceptable\": true"), std::string::npos) << json;
 }
 

@@ -33,15 +33,18 @@ class MazeExplorer : public ::testing::TestWithParam<std::tuple<std::string, int
 
 TEST_P(MazeExplorer, MapsTheReachableSpaceAndReturnsHomeWithoutCollision) {
   const auto& [arena, seed] = GetParam();
-  const std::string j = RunConfig("maze_explorer.ini", "maze_explorer_" + arena + "_" + std::to_string(seed),
-                                  {"pipeline.seed=" + std::to_string(seed),
-                                   "source.path=" + std::string(MBOT_SOURCE_DIR) + "/datasets/arenas/" + arena + ".arena"},
-                                  "score.json");
+  const std::string j =
+      RunConfig("maze_explorer.ini", "maze_explorer_" + arena + "_" + std::to_string(seed),
+                {"pipeline.seed=" + std::to_string(seed),
+                 "source.path=" + std::string(MBOT_SOURCE_DIR) + "/datasets/arenas/" + arena + ".arena"},
+                "score.json");
   ExpectExploredMappedAndHome(j);
 }
 INSTANTIATE_TEST_SUITE_P(ArenasAndSeeds, MazeExplorer,
                          ::testing::Combine(::testing::Values("maze_1", "maze_2", "maze_3"), ::testing::Values(1, 2)),
-                         [](const auto& info) { return std::get<0>(info.param) + "_seed" + std::to_string(std::get<1>(info.param)); });
+                         [](const auto& info) {
+                           return std::get<0>(info.param) + "_seed" + std::to_string(std::get<1>(info.param));
+                         });
 
 class Warehouse : public ::testing::TestWithParam<int> {};
 
@@ -102,18 +105,19 @@ TEST(MazeExplorer, InterruptedRunStillWritesMapTrajectoriesAndScore) {
 // log: the same scans, and SLAM on the replay as accurate as it was live (a replay is its own SLAM
 // run with the same seed, so the figures agree within noise, not to the bit).
 TEST(Recording, ASimulatedRunReplaysThroughTheLogSource) {
-  const std::string live = RunConfig("speed_run.ini", "recorded_speed_run",
-                                     {"pipeline.stages=slam, mission, referee, recorder", "recorder.type=recorder"},
-                                     "metrics.json");
+  const std::string live =
+      RunConfig("speed_run.ini", "recorded_speed_run",
+                {"pipeline.stages=slam, mission, referee, recorder", "recorder.type=recorder"}, "metrics.json");
   ASSERT_FALSE(live.empty());
   const std::string log = ::testing::TempDir() + "/recorded_speed_run/recording.log";
   ASSERT_TRUE(std::filesystem::exists(log));
   const std::string out = ::testing::TempDir() + "/recorded_speed_run_replay";
   std::filesystem::remove_all(out);
-  auto c = config::Config::FromString("include = defaults.ini\n[pipeline]\nstages = slam\nprogress = off\n[source]\npath = " + log +
-                                          "\n[output]\ndir = " + out +
-                                          "\n[slam]\ntype = slam\nmode = full_slam\nparticles = 300\ninitial_pose = origin\n",
-                                      "replay.ini", std::string(MBOT_SOURCE_DIR) + "/config");
+  auto c = config::Config::FromString(
+      "include = defaults.ini\n[pipeline]\nstages = slam\nprogress = off\n[source]\npath = " + log +
+          "\n[output]\ndir = " + out +
+          "\n[slam]\ntype = slam\nmode = full_slam\nparticles = 300\ninitial_pose = origin\n",
+      "replay.ini", std::string(MBOT_SOURCE_DIR) + "/config");
   auto plan = BuildPlan(c);
   std::atomic<bool> stop{false};
   RunPlan(plan, stop);
@@ -125,7 +129,8 @@ TEST(Recording, ASimulatedRunReplaysThroughTheLogSource) {
   EXPECT_EQ(Get(replay, {"scans"}), Get(live, {"scans"}));
   EXPECT_EQ(Get(replay, {"scans_skipped"}), 0);
   EXPECT_LT(Get(replay, {"slam_ate", "aligned", "xy_m", "rmse"}), 0.02);
-  EXPECT_NEAR(Get(replay, {"slam_ate", "aligned", "xy_m", "rmse"}), Get(live, {"slam_ate", "aligned", "xy_m", "rmse"}), 0.01);
+  EXPECT_NEAR(Get(replay, {"slam_ate", "aligned", "xy_m", "rmse"}), Get(live, {"slam_ate", "aligned", "xy_m", "rmse"}),
+              0.01);
 }
 
 // The README's first command: config/competition.ini runs every simulated event with one seed and
@@ -166,13 +171,19 @@ TEST(Competition, ConfigErrorsNameTheSectionAndKeyBeforeAnythingRuns) {
     }
   };
   expect_error("[competition]\nevents = speed_run\n", "event 'speed_run' has no [speed_run] section");
-  expect_error("[competition]\nevents = speed_run\n[speed_run]\nconfig = " + dir + "/speed_run.ini\n[maze]\nworld = x\n", "[maze] is not used");
-  expect_error("[competition]\nevents = speed_run\n[speed_run]\nconfig = " + dir + "/speed_run.ini\nworld = nowhere.arena\n",
-               "[speed_run] world: nowhere.arena: no such file");
-  expect_error("[competition]\nevents = speed_run\n[speed_run]\nconfig = " + dir + "/speed_run.ini\nset = mission.max_sped_m_s=1\n",
-               "[speed_run] (config = " + dir + "/speed_run.ini, with this section's seed, world and set): --set: [mission] max_sped_m_s");
+  expect_error(
+      "[competition]\nevents = speed_run\n[speed_run]\nconfig = " + dir + "/speed_run.ini\n[maze]\nworld = x\n",
+      "[maze] is not used");
+  expect_error(
+      "[competition]\nevents = speed_run\n[speed_run]\nconfig = " + dir + "/speed_run.ini\nworld = nowhere.arena\n",
+      "[speed_run] world: nowhere.arena: no such file");
+  expect_error("[competition]\nevents = speed_run\n[speed_run]\nconfig = " + dir +
+                   "/speed_run.ini\nset = mission.max_sped_m_s=1\n",
+               "[speed_run] (config = " + dir +
+                   "/speed_run.ini, with this section's seed, world and set): --set: [mission] max_sped_m_s");
   expect_error("[competition]\nevents = speed_run\n[speed_run]\n", "[speed_run] config: required");
-  expect_error("[competition]\nevents = speed_run\n[speed_run]\nconfig = nowhere.ini\n", "[speed_run] config: nowhere.ini");
+  expect_error("[competition]\nevents = speed_run\n[speed_run]\nconfig = nowhere.ini\n",
+               "[speed_run] config: nowhere.ini");
 }
 
 // One event of the competition, a world with a comma-separated start and several overrides.

@@ -29,20 +29,23 @@ TEST(MissionFollow, DrivesThePathAGuiSendsAndStandsStillBefore) {
   mission->OnEvent(Event{0, 0, "SLAM_POSE", EventKind::kPoseEstimate, origin});
   int64_t t = 0;
   auto odometry = [&](double seconds) {
-    for (int i = 0; i < seconds * 50; ++i, t += 20'000) mission->OnEvent(Event{t, t, "MBOT_ODOMETRY", EventKind::kOdometry, origin});
+    for (int i = 0; i < seconds * 50; ++i, t += 20'000)
+      mission->OnEvent(Event{t, t, "MBOT_ODOMETRY", EventKind::kOdometry, origin});
   };
   auto max_speed = [&] {
     double v = 0;
     for (const Event& e : bus.events) {
-      if (e.kind == EventKind::kMotorCommand) v = std::max(v, std::get<drivers::MotorCommand>(e.payload).velocity.v_m_s);
+      if (e.kind == EventKind::kMotorCommand)
+        v = std::max(v, std::get<drivers::MotorCommand>(e.payload).velocity.v_m_s);
     }
     return v;
   };
   odometry(0.5);
   EXPECT_EQ(max_speed(), 0.0);
   bool waiting = false;
-  for (const Event& e : bus.events) waiting = waiting || (e.kind == EventKind::kMissionStatus &&
-                                                  std::get<mission::MissionStatus>(e.payload).state == mission::MissionState::kWaiting);
+  for (const Event& e : bus.events)
+    waiting = waiting || (e.kind == EventKind::kMissionStatus &&
+                          std::get<mission::MissionStatus>(e.payload).state == mission::MissionState::kWaiting);
   EXPECT_TRUE(waiting);
   bus.events.clear();
   mission->OnEvent(Event{t, t, "CONTROLLER_PATH", EventKind::kPath, drivers::Path{{{1.0, 0.0, 0.0}}}});

@@ -30,7 +30,9 @@ TEST(PipelineTest, BuildsRegisteredStages) {
 
 TEST(PipelineTest, UnknownStageTypeListsTheKnownOnes) {
   const auto e = ErrorOf(std::string(kBase) + "[s]\ntype = nope\n");
-  EXPECT_NE(e.find("t.ini:6: [s] type: unknown stage type 'nope' (known: action_model_fit, astar_test, exploration, inspect, lcm_bridge, map_writer, mission, motor_calibration, movingai_benchmark, odometry, recorder, referee, slam, trajectory_writer)"),
+  EXPECT_NE(e.find("t.ini:6: [s] type: unknown stage type 'nope' (known: action_model_fit, astar_test, exploration, "
+                   "inspect, lcm_bridge, map_writer, mission, motor_calibration, movingai_benchmark, odometry, "
+                   "recorder, referee, slam, trajectory_writer)"),
             std::string::npos)
       << e;
 }
@@ -43,8 +45,9 @@ TEST(PipelineTest, StrictErrors) {
             std::string::npos);
   EXPECT_NE(ErrorOf("[pipeline]\nstages = s\n[s]\ntype = inspect\n").find("[source] path: required key is missing"),
             std::string::npos);
-  EXPECT_NE(ErrorOf(std::string(kBase) + "type = lcm\n[s]\ntype = inspect\n").find("[source] type: 'lcm' is not one of"),
-            std::string::npos);
+  EXPECT_NE(
+      ErrorOf(std::string(kBase) + "type = lcm\n[s]\ntype = inspect\n").find("[source] type: 'lcm' is not one of"),
+      std::string::npos);
 }
 
 // Every shipped configuration parses strictly (keys, sections, stage types, values). A fragment

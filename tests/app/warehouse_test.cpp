@@ -55,12 +55,14 @@ TEST(WarehouseRules, TheSeedDecidesTheOrder) {
 }
 
 TEST(WarehouseRules, AnArenaWithoutEnoughTargetsIsNamed) {
-  const sim::World w = sim::World::ParseArena("name tiny\nbox 0 0 2 2\npose target 1 1 0\npose dropoff 0.5 0.5 0\n", "tiny.arena");
+  const sim::World w =
+      sim::World::ParseArena("name tiny\nbox 0 0 2 2\npose target 1 1 0\npose dropoff 0.5 0.5 0\n", "tiny.arena");
   try {
     StopsOf(w, 1);
     ADD_FAILURE();
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("needs 7 targets and at least one drop-off (has 1 and 1)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("needs 7 targets and at least one drop-off (has 1 and 1)"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -93,7 +95,8 @@ TEST(DayInputs, TheShippedKeysAreTheShippedArenas) {
   expect_same(w.targets, day.targets, "targets");
   expect_same(w.dropoffs, day.dropoffs, "drop-offs");
   const mission::MissionOptions s = mission_of("speed_run.ini");
-  expect_same(s.waypoints, sim::EventInputsOf(sim::World::Load(dir + "/datasets/arenas/convex_circuit.arena")).waypoints,
+  expect_same(s.waypoints,
+              sim::EventInputsOf(sim::World::Load(dir + "/datasets/arenas/convex_circuit.arena")).waypoints,
               "waypoints");
   // The given map is the arena drawn at the SLAM resolution.
   std::string format;

@@ -182,8 +182,8 @@ void Label(benchmark::State& state, int particles, const std::string& what, cons
            const Pose2D& odometry) {
   state.counters["particles"] = particles;
   state.counters["odom_gap_m"] = std::hypot(estimate.x - odometry.x, estimate.y - odometry.y);
-  state.SetLabel(what + ", " + std::to_string(Data().scans.size()) + " scans of <= " +
-                 std::to_string(Data().beams_max) + " beams");
+  state.SetLabel(what + ", " + std::to_string(Data().scans.size()) +
+                 " scans of <= " + std::to_string(Data().beams_max) + " beams");
 }
 
 // Args: particle count, threads (0: all cores).
@@ -217,8 +217,7 @@ void BM_ParticleFilter_Ours(benchmark::State& state) {
     const mapping::FilterStatus status = filter.Update(action, step, sensor, points);
     benchmark::DoNotOptimize(status.pose.x);
   }
-  Label(state, particles, threads == 1 ? "ours, 1 thread" : "ours, all cores", filter.status().pose,
-        d.odometry[last]);
+  Label(state, particles, threads == 1 ? "ours, 1 thread" : "ours, all cores", filter.status().pose, d.odometry[last]);
 }
 
 // MRPT's grid from ours: same extent and cells. MRPT cells hold the probability of being FREE, and
@@ -268,9 +267,7 @@ void BM_ParticleFilter_MRPT(benchmark::State& state) {
   mrpt::slam::CMonteCarloLocalization2D pdf(particles);
   pdf.options.metricMap = map;
   // A uniform box of ±0.05 m and ±0.05 rad around the start, like our InitializeAt(pose, 0.05, 0.05).
-  const auto reset = [&] {
-    pdf.resetAroundSetOfPoses({ToMrpt(d.odometry[0]).asTPose()}, particles, 0.1, 0.1, 0.1);
-  };
+  const auto reset = [&] { pdf.resetAroundSetOfPoses({ToMrpt(d.odometry[0]).asTPose()}, particles, 0.1, 0.1, 0.1); };
   reset();
 
   mrpt::bayes::CParticleFilter pf;
@@ -351,9 +348,15 @@ void MrptArgs(benchmark::internal::Benchmark* b) {
   for (int64_t n : kParticleCounts) b->Args({n});
 }
 
-BENCHMARK(BM_ParticleFilter_Ours)->Apply(OursArgs)->ArgNames({"particles", "threads"})->UseRealTime()
+BENCHMARK(BM_ParticleFilter_Ours)
+    ->Apply(OursArgs)
+    ->ArgNames({"particles", "threads"})
+    ->UseRealTime()
     ->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_ParticleFilter_MRPT)->Apply(MrptArgs)->ArgNames({"particles"})->UseRealTime()
+BENCHMARK(BM_ParticleFilter_MRPT)
+    ->Apply(MrptArgs)
+    ->ArgNames({"particles"})
+    ->UseRealTime()
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_MapUpdate_LogOdds)->UseRealTime()->Unit(benchmark::kMicrosecond);
 

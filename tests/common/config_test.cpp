@@ -50,7 +50,10 @@ TEST(ConfigTest, MalformedAndOutOfRangeValues) {
   EXPECT_NE(ErrorOf([&] { s.GetDouble("d", 0, "", 0.0, 1.0); }).find("t.ini:3: [a] d: value 5 out of range"),
             std::string::npos);
   EXPECT_NE(ErrorOf([&] { s.GetBool("b", false, ""); }).find("expected true or false"), std::string::npos);
-  EXPECT_NE(ErrorOf([&] { s.GetChoice("ch", "x", {"x", "y"}, ""); }).find("'z' is not one of: x, y"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] {
+              s.GetChoice("ch", "x", {"x", "y"}, "");
+            }).find("'z' is not one of: x, y"),
+            std::string::npos);
 }
 
 TEST(ConfigTest, SyntaxErrorsNameTheLine) {

@@ -19,7 +19,8 @@ Event RoundTrip(const Event& in) {
 }
 
 TEST(LcmMessages, VelocityCommandRoundTrips) {
-  const Event out = RoundTrip(Event{0, 123, "MBOT_VEL_CMD", EventKind::kMotorCommand, MotorCommand::Velocity(0.25, -1.5)});
+  const Event out =
+      RoundTrip(Event{0, 123, "MBOT_VEL_CMD", EventKind::kMotorCommand, MotorCommand::Velocity(0.25, -1.5)});
   ASSERT_EQ(out.kind, EventKind::kMotorCommand);
   const auto& c = std::get<MotorCommand>(out.payload);
   EXPECT_EQ(c.kind, MotorCommand::Kind::kVelocity);
@@ -43,13 +44,16 @@ TEST(LcmMessages, PwmAndMeasuredWheelSpeedsAreDistinctTypes) {
 // go out as exploring; the rest keep their meaning.
 TEST(LcmMessages, MissionStatesGoOutAsTheBotlabExplorationStates) {
   using mission::MissionState;
-  const std::pair<MissionState, MissionState> cases[] = {
-      {MissionState::kInitializing, MissionState::kInitializing}, {MissionState::kExploring, MissionState::kExploring},
-      {MissionState::kReturningHome, MissionState::kReturningHome}, {MissionState::kCompleted, MissionState::kCompleted},
-      {MissionState::kFailed, MissionState::kFailed},               {MissionState::kDriving, MissionState::kExploring},
-      {MissionState::kLifting, MissionState::kExploring}};
+  const std::pair<MissionState, MissionState> cases[] = {{MissionState::kInitializing, MissionState::kInitializing},
+                                                         {MissionState::kExploring, MissionState::kExploring},
+                                                         {MissionState::kReturningHome, MissionState::kReturningHome},
+                                                         {MissionState::kCompleted, MissionState::kCompleted},
+                                                         {MissionState::kFailed, MissionState::kFailed},
+                                                         {MissionState::kDriving, MissionState::kExploring},
+                                                         {MissionState::kLifting, MissionState::kExploring}};
   for (const auto& [sent, received] : cases) {
-    const Event out = RoundTrip(Event{0, 9, "EXPLORATION_STATUS", EventKind::kMissionStatus, mission::MissionStatus{sent, "x"}});
+    const Event out =
+        RoundTrip(Event{0, 9, "EXPLORATION_STATUS", EventKind::kMissionStatus, mission::MissionStatus{sent, "x"}});
     ASSERT_EQ(out.kind, EventKind::kMissionStatus);
     EXPECT_EQ(std::get<mission::MissionStatus>(out.payload).state, received) << mission::ToString(sent);
   }
@@ -57,9 +61,10 @@ TEST(LcmMessages, MissionStatesGoOutAsTheBotlabExplorationStates) {
 
 TEST(LcmMessages, SlamStatusCarriesTheMode) {
   std::vector<uint8_t> bytes;
-  ASSERT_TRUE(lcm_adapter::Encode(Event{0, 1, "SLAM_STATUS", EventKind::kSlamStatus,
-                                        mapping::SlamStatus{mapping::SlamState::kLocalized, mapping::SlamMode::kLocalization, 0.1}},
-                                  &bytes));
+  ASSERT_TRUE(lcm_adapter::Encode(
+      Event{0, 1, "SLAM_STATUS", EventKind::kSlamStatus,
+            mapping::SlamStatus{mapping::SlamState::kLocalized, mapping::SlamMode::kLocalization, 0.1}},
+      &bytes));
   const lcm_adapter::TypeInfo* type = lcm_adapter::LookUp(lcm_adapter::Fingerprint(bytes.data(), bytes.size()));
   ASSERT_NE(type, nullptr);
   EXPECT_EQ(type->type, "slam_status_t");

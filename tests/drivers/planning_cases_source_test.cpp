@@ -12,9 +12,7 @@
 namespace mbot::drivers {
 namespace {
 
-void WriteText(const std::string& path, const std::string& text) {
-  std::ofstream(path) << text;
-}
+void WriteText(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
 
 std::string BotlabFixture(const std::string& dir_name, const std::string& poses) {
   const std::string dir = test::TempPath(dir_name);
@@ -61,15 +59,14 @@ TEST(PlanningCasesSourceTest, MovingAiScenariosFlipRowsAndFindTheirMap) {
   std::filesystem::create_directories(root + "/maps/set");
   std::filesystem::create_directories(root + "/scenarios/set");
   WriteText(root + "/maps/set/tiny.map", "type octile\r\nheight 3\r\nwidth 4\r\nmap\r\n....\r\n.@@.\r\n....\r\n");
-  WriteText(root + "/scenarios/set/tiny.map.scen",
-            "version 1\n0\tmaps/set/tiny.map\t4\t3\t0\t0\t3\t2\t3.82842712\n\n");
+  WriteText(root + "/scenarios/set/tiny.map.scen", "version 1\n0\tmaps/set/tiny.map\t4\t3\t0\t0\t3\t2\t3.82842712\n\n");
   const std::string scen = root + "/scenarios/set/tiny.map.scen";
   EXPECT_EQ(DetectFormat(scen), "movingai");
   PlanningCasesSource src(scen, "movingai");
   auto map = src.Next();
   ASSERT_TRUE(map);
   const auto& grid = *std::get<std::shared_ptr<const mapping::OccupancyGrid>>(map->payload);
-  EXPECT_GT(grid.at(1, 1), 0);  // the '@' row is the middle one either way
+  EXPECT_GT(grid.at(1, 1), 0);                                       // the '@' row is the middle one either way
   const PlanRequest r = std::get<PlanRequest>(src.Next()->payload);  // a copy: the event is a temporary
   EXPECT_EQ(r.start.x, 0.5);
   EXPECT_EQ(r.start.y, 2.5);  // Moving AI row 0 is the top: grid row 2

@@ -53,7 +53,8 @@ TEST(LcmLive, MalformedPacketsOnEverySubscribedChannelAreRejectedAndCountedAndTh
   scan.ranges_m = {1.0f, 2.0f, 3.0f};
   scan.angles_rad = {0.0f, 0.1f, 0.2f};
   const std::vector<uint8_t> lidar = EncodeEvent(Event{0, 5, "LIDAR", EventKind::kLidar, scan});
-  const std::vector<uint8_t> pose = EncodeEvent(Event{0, 5, "MBOT_ODOMETRY", EventKind::kOdometry, motion::Pose2D{1, 2, 0.5}});
+  const std::vector<uint8_t> pose =
+      EncodeEvent(Event{0, 5, "MBOT_ODOMETRY", EventKind::kOdometry, motion::Pose2D{1, 2, 0.5}});
   ASSERT_FALSE(lidar.empty());
   ASSERT_EQ(pose.size(), 8u + 8 + 12);
   int bad = 0;
@@ -73,8 +74,9 @@ TEST(LcmLive, MalformedPacketsOnEverySubscribedChannelAreRejectedAndCountedAndTh
   std::vector<uint8_t> nan_pose = pose;  // x = NaN
   nan_pose[16] = 0x7f, nan_pose[17] = 0xc0, nan_pose[18] = 0, nan_pose[19] = 0;
   robot.PublishRaw("MBOT_ODOMETRY", nan_pose);
-  robot.PublishRaw("MBOT_ODOMETRY", EncodeEvent(Event{0, -5, "MBOT_ODOMETRY", EventKind::kOdometry, motion::Pose2D{1, 2, 0.5}}));
-  bad += 3;  // and a negative utime
+  robot.PublishRaw("MBOT_ODOMETRY",
+                   EncodeEvent(Event{0, -5, "MBOT_ODOMETRY", EventKind::kOdometry, motion::Pose2D{1, 2, 0.5}}));
+  bad += 3;                                 // and a negative utime
   robot.PublishRaw("MBOT_ODOMETRY", pose);  // and one good message: it still passes
   const std::vector<Event> got = Drain(*source, 0.5);
   EXPECT_EQ(source->diagnostics().rejected_messages, bad);

@@ -152,7 +152,8 @@ TEST(SensorModel, UpdatingAMapGivesTheSameTablesAsBuildingItAfresh) {
         double x, y;
         room.map.CellToWorld(cx, cy, &x, &y);
         const Pose2D at{x, y, 0};
-        ASSERT_EQ(updated.LogLikelihood(at, one), fresh.LogLikelihood(at, one)) << cx << "," << cy << " kind " << int(kind);
+        ASSERT_EQ(updated.LogLikelihood(at, one), fresh.LogLikelihood(at, one))
+            << cx << "," << cy << " kind " << int(kind);
         ASSERT_EQ(updated.InlierFraction(at, one), fresh.InlierFraction(at, one)) << cx << "," << cy;
       }
     }

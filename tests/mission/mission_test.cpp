@@ -150,7 +150,8 @@ TEST(MissionWarehouse, WaitsForLocalizationThenVisitsEveryStopInOrder) {
   EXPECT_EQ(run.Run(600), MissionState::kCompleted) << m.status().detail;
   const auto stops = warehouse::Stops(o.targets, o.dropoffs, 4);
   int lifts = 0, set_downs = 0;
-  for (const MissionStatus& s : run.statuses) lifts += s.state == MissionState::kLifting, set_downs += s.state == MissionState::kSettingDown;
+  for (const MissionStatus& s : run.statuses)
+    lifts += s.state == MissionState::kLifting, set_downs += s.state == MissionState::kSettingDown;
   EXPECT_EQ(lifts, 7);
   EXPECT_EQ(set_downs, 7);
   EXPECT_EQ(m.Report().stops_done, 14);

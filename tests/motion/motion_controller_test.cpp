@@ -107,9 +107,9 @@ TEST(RotateTranslateRotateTest, SquareFourLapsClosesAndRespectsLimits) {
       worst_closest = std::max(worst_closest, closest[k]);
     }
     EXPECT_LT(closest.back(), o.final_tolerance_m) << "lap " << lap;
-    RecordProperty("closest_lap" + std::to_string(lap),
-                   std::to_string(closest[0]) + " " + std::to_string(closest[1]) + " " +
-                       std::to_string(closest[2]) + " " + std::to_string(closest[3]));
+    RecordProperty("closest_lap" + std::to_string(lap), std::to_string(closest[0]) + " " + std::to_string(closest[1]) +
+                                                            " " + std::to_string(closest[2]) + " " +
+                                                            std::to_string(closest[3]));
   }
   const double closure = std::hypot(pose.x, pose.y);
   EXPECT_LT(closure, 0.05);

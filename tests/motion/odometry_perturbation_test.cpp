@@ -35,7 +35,7 @@ TEST(OdometryPerturbation, NoiseGrowsWithDistanceAndIsSeeded) {
   EXPECT_DOUBLE_EQ(a.x, b.x);
   EXPECT_NE(a.x, c.x);
   EXPECT_GT(std::hypot(a.x - 1.0, a.y) + std::abs(a.theta), 1e-4);  // perturbed
-  EXPECT_LT(std::hypot(a.x - 1.0, a.y), 0.5);                        // but not wildly
+  EXPECT_LT(std::hypot(a.x - 1.0, a.y), 0.5);                       // but not wildly
 }
 
 TEST(TrajectoryErrors, AnEstimateOffsetByARigidMotionIsPerfectOnceAligned) {

@@ -27,13 +27,14 @@ struct SpeedTrace {
 // Drives the left wheel alone (ω chosen so the right target is 0 is not needed: both wheels run
 // the same command) and records the left target and speed.
 SpeedTrace Simulate(const WheelControllerOptions& o, const MotorCalibration& model, const WheelCalibration& plant,
-             const std::vector<std::pair<double, double>>& v_schedule, double seconds) {
+                    const std::vector<std::pair<double, double>>& v_schedule, double seconds) {
   WheelSpeedController c(o, RobotGeometry{}, model);
   FirstOrderMotor left{plant}, right{plant};
   SpeedTrace r;
   for (int k = 0; k * o.dt_s < seconds; ++k) {
     double v = 0;
-    for (const auto& [from_s, value] : v_schedule) if (k * o.dt_s >= from_s) v = value;
+    for (const auto& [from_s, value] : v_schedule)
+      if (k * o.dt_s >= from_s) v = value;
     const WheelDuties d = c.Update(v, 0.0, left.speed, right.speed);
     left.Step(d.left, o.dt_s);
     right.Step(d.right, o.dt_s);

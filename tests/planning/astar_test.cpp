@@ -248,7 +248,7 @@ TEST(AStarPlannerTest, PlanSteppingOutLeavesTheRadiusFirst) {
   ASSERT_EQ(r.status, PlanStatus::kFound);
   ASSERT_GE(r.path.size(), 3u);
   EXPECT_DOUBLE_EQ(r.path.front().x, start.x);
-  EXPECT_GT(planner.DistanceAt(r.path[1].x, r.path[1].y), 0.12);        // out of the radius
+  EXPECT_GT(planner.DistanceAt(r.path[1].x, r.path[1].y), 0.12);             // out of the radius
   EXPECT_LT(std::hypot(r.path[1].x - start.x, r.path[1].y - start.y), 0.1);  // by a short step
   EXPECT_NEAR(r.path.back().x, goal.x, 1e-9);
   // A clear start plans as Plan does.

@@ -25,7 +25,8 @@ struct ScriptedRun {
 
 // Marks what a 360° sensor of `range_m` sees from (x, y): free cells along each ray up to the first
 // occupied cell (marked occupied). Cells unknown in the truth stop the ray and stay unknown.
-inline void Reveal(const mapping::OccupancyGrid& truth, double x, double y, double range_m, mapping::OccupancyGrid* known) {
+inline void Reveal(const mapping::OccupancyGrid& truth, double x, double y, double range_m,
+                   mapping::OccupancyGrid* known) {
   const double res = truth.resolution();
   const int rays = static_cast<int>(std::ceil(2 * M_PI * range_m / res));
   for (int i = 0; i < rays; ++i) {
@@ -79,13 +80,14 @@ inline std::vector<int> ReachableCells(const mapping::OccupancyGrid& truth, cons
 }
 
 // Drives the explorer to the end (or `max_updates`). `on_update` may change the truth mid-run.
-inline ScriptedRun RunScripted(mapping::OccupancyGrid truth, const motion::Pose2D& home, const ExplorationOptions& options,
-                               double sensor_range_m, int max_updates = 5000,
+inline ScriptedRun RunScripted(mapping::OccupancyGrid truth, const motion::Pose2D& home,
+                               const ExplorationOptions& options, double sensor_range_m, int max_updates = 5000,
                                const std::function<void(int, const motion::Pose2D&, mapping::OccupancyGrid*,
                                                         mapping::OccupancyGrid*)>& on_update = nullptr) {
   ScriptedRun run;
   Explorer explorer(options);
-  mapping::OccupancyGrid known(truth.width(), truth.height(), truth.resolution(), truth.origin_x(), truth.origin_y(), 0);
+  mapping::OccupancyGrid known(truth.width(), truth.height(), truth.resolution(), truth.origin_x(), truth.origin_y(),
+                               0);
   ObstacleDistanceGrid true_distance(truth, {true, 0});
   motion::Pose2D pose = home;
   std::vector<motion::Pose2D> path;

@@ -22,7 +22,7 @@ OccupancyGrid Arena() {
   wall(0, 59, 79, 59);
   wall(0, 0, 0, 59);
   wall(79, 0, 79, 59);
-  wall(30, 0, 30, 40);   // room 1 | room 2, door at the top (rows 41..50)
+  wall(30, 0, 30, 40);  // room 1 | room 2, door at the top (rows 41..50)
   wall(30, 51, 30, 59);
   wall(55, 20, 79, 20);  // room 2 / room 3 below, door at columns 31..40
   wall(41, 20, 54, 20);

@@ -42,8 +42,7 @@ TEST(FrontiersTest, GoalIsCentroidOrNearestReachableCell) {
   AStarPlanner planner;
   planner.SetMap(ObstacleDistanceGrid(g, {true, 0}));
   std::vector<int> unreachable;
-  const std::vector<FrontierGoal> goals =
-      RankFrontierGoals(f, {0.5, 1.0, 0}, g, planner, 0.10, {5, 1.0}, &unreachable);
+  const std::vector<FrontierGoal> goals = RankFrontierGoals(f, {0.5, 1.0, 0}, g, planner, 0.10, {5, 1.0}, &unreachable);
   ASSERT_EQ(goals.size(), 1u);
   EXPECT_TRUE(unreachable.empty());
   // The centroid lies on the frontier (0.05 m from unknown space): not reachable with 0.10 m
@@ -72,7 +71,7 @@ TEST(FrontiersTest, GoalSeesTheFrontierRatherThanStandingBehindAWall) {
   for (int y = 18; y < 40; ++y) {
     for (int x = 6; x <= 12; ++x) g.at(x, y) = 100;  // the thick wall above y = 0.9 m
   }
-  for (int y = 10; y < 18; ++y) g.at(12, y) = 100;  // the two corridors are apart from y = 0.5 m
+  for (int y = 10; y < 18; ++y) g.at(12, y) = 100;                 // the two corridors are apart from y = 0.5 m
   for (int x = 13; x < 39; ++x) g.at(x, 30) = g.at(x, 31) = -100;  // the second corridor is known higher up
   for (int x = 13; x < 39; ++x) g.at(x, 32) = 100;
   const std::vector<Frontier> f = FindFrontiers(g, {5, 1.0});

@@ -13,11 +13,11 @@ class BotlabArena : public ::testing::TestWithParam<int> {};
 
 TEST_P(BotlabArena, MazeExplorerMapsCenterMazeAndReturnsHomeWithoutCollision) {
   const int seed = GetParam();
-  const std::string j = RunConfig("maze_explorer.ini", "botlab_center_maze_" + std::to_string(seed),
-                                  {"pipeline.seed=" + std::to_string(seed),
-                                   "source.path=${datasets}/botlab/mbot_example_logs_maps/center_maze.map",
-                                   "source.start=-0.9, -0.6, 45"},  // the bottom-left corner, facing the middle
-                                  "score.json");
+  const std::string j = RunConfig(
+      "maze_explorer.ini", "botlab_center_maze_" + std::to_string(seed),
+      {"pipeline.seed=" + std::to_string(seed), "source.path=${datasets}/botlab/mbot_example_logs_maps/center_maze.map",
+       "source.start=-0.9, -0.6, 45"},  // the bottom-left corner, facing the middle
+      "score.json");
   ExpectExploredMappedAndHome(j);
 }
 INSTANTIATE_TEST_SUITE_P(Seeds, BotlabArena, ::testing::Values(1, 2));

@@ -131,17 +131,16 @@ TEST_P(LegacyLogTest, ChannelsCountsRatesAndGroundTruth) {
   EXPECT_EQ(s.diagnostics.unknown_messages, 0);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Botlab, LegacyLogTest,
-    ::testing::Values(LegacyLog{"sweep_drive_square_10mx10m_5cm.log", 125, 2428, 1240, 620},
-                      LegacyLog{"sweep_convex_10mx10m_5cm.log", 133, 2543, 1324, 662},
-                      LegacyLog{"sweep_convex_10mx10m_5cm_offcenter.log", 107, 1871, 1060, 530}),
-    [](const ::testing::TestParamInfo<LegacyLog>& i) {
-      std::string n = i.param.file;
-      n = n.substr(0, n.find('.'));
-      for (char& ch : n) ch = std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
-      return n;
-    });
+INSTANTIATE_TEST_SUITE_P(Botlab, LegacyLogTest,
+                         ::testing::Values(LegacyLog{"sweep_drive_square_10mx10m_5cm.log", 125, 2428, 1240, 620},
+                                           LegacyLog{"sweep_convex_10mx10m_5cm.log", 133, 2543, 1324, 662},
+                                           LegacyLog{"sweep_convex_10mx10m_5cm_offcenter.log", 107, 1871, 1060, 530}),
+                         [](const ::testing::TestParamInfo<LegacyLog>& i) {
+                           std::string n = i.param.file;
+                           n = n.substr(0, n.find('.'));
+                           for (char& ch : n) ch = std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
+                           return n;
+                         });
 
 TEST(BotlabLogs, DriveSquareGroundTruthTravelsAboutFourMetres) {
   SourceOptions o;
@@ -275,7 +274,8 @@ INSTANTIATE_TEST_SUITE_P(Carmen, CarmenLogTest,
                                            CarmenLog{"csail-corrected.log.gz", 406, 361, 0.5, 2394}),
                          [](const ::testing::TestParamInfo<CarmenLog>& i) {
                            std::string n = i.param.file;
-                           n = n.substr(0, n.find('-', n.find('-') + 1) == std::string::npos ? n.find('-') : n.find("-corrected"));
+                           n = n.substr(0, n.find('-', n.find('-') + 1) == std::string::npos ? n.find('-')
+                                                                                             : n.find("-corrected"));
                            for (char& ch : n) ch = std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
                            return n;
                          });

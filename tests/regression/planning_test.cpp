@@ -28,7 +28,8 @@ TEST(PlanningRegressionTest, BotlabAStarCasesAllPassThroughTheShippedConfig) {
   for (const char* map : {"convex", "empty", "filled", "maze", "narrow", "wide"}) {
     EXPECT_NE(out.find(std::string(map) + std::string(10 - std::string(map).size() + 1, ' ') + "PASSED"),
               std::string::npos)
-        << map << "\n" << out;
+        << map << "\n"
+        << out;
   }
 }
 
@@ -61,7 +62,8 @@ INSTANTIATE_TEST_SUITE_P(BotlabArenas, ExplorationRegressionTest,
                          ::testing::Values(ArenaCase{"botlab/astar/maze.map", {0.0, 0.0, 0.0}},
                                            ArenaCase{"botlab/mbot_example_logs_maps/drive_maze.map", {0.0, 0.0, 0.0}},
                                            ArenaCase{"botlab/mbot_example_logs_maps/center_maze.map", {0.0, 0.0, 0.0}},
-                                           ArenaCase{"botlab/mbot_example_logs_maps/drive_square.map", {0.0, 0.0, 0.0}}),
+                                           ArenaCase{"botlab/mbot_example_logs_maps/drive_square.map",
+                                                     {0.0, 0.0, 0.0}}),
                          [](const auto& info) {
                            std::string n = info.param.map;
                            n = n.substr(n.rfind('/') + 1);

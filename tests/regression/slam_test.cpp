@@ -43,8 +43,8 @@ double Rmse(const std::string& j, const char* who, const char* how, const char* 
 TEST(SlamRegression, FullSlamOnDriveSquareMatchesOrBeatsTheStaffSlamForThreeSeeds) {
   for (int seed : {1, 2, 3}) {
     const std::string j = RunSlam("slam_replay.ini", "drive_square_" + std::to_string(seed),
-                              {"pipeline.seed=" + std::to_string(seed),
-                               "source.path=" + Data(kLegacy + "sweep_drive_square_10mx10m_5cm.log")});
+                                  {"pipeline.seed=" + std::to_string(seed),
+                                   "source.path=" + Data(kLegacy + "sweep_drive_square_10mx10m_5cm.log")});
     const double x = Rmse(j, "slam_ate", "aligned", "x_m"), y = Rmse(j, "slam_ate", "aligned", "y_m");
     const double xy = Rmse(j, "slam_ate", "aligned", "xy_m"), th = Rmse(j, "slam_ate", "aligned", "theta_deg");
     const double staff = Rmse(j, "reference_ate", "aligned", "xy_m");
@@ -64,10 +64,11 @@ TEST(SlamRegression, FullSlamOnDriveSquareMatchesOrBeatsTheStaffSlamForThreeSeed
 
 TEST(SlamRegression, FullSlamOnMaebotConvexFromEncodersForThreeSeeds) {
   for (int seed : {1, 2, 3}) {
-    const std::string j = RunSlam("slam_replay.ini", "maebot_" + std::to_string(seed),
-                              {"pipeline.seed=" + std::to_string(seed), "source.path=" + Data(kLegacy + "maebot_convex.log"),
-                               "slam.odometry=encoders", "slam.left_m_per_tick=8.7e-5", "slam.right_m_per_tick=8.7e-5",
-                               "slam.wheel_base_m=0.092", "slam.initial_pose=ground_truth"});
+    const std::string j =
+        RunSlam("slam_replay.ini", "maebot_" + std::to_string(seed),
+                {"pipeline.seed=" + std::to_string(seed), "source.path=" + Data(kLegacy + "maebot_convex.log"),
+                 "slam.odometry=encoders", "slam.left_m_per_tick=8.7e-5", "slam.right_m_per_tick=8.7e-5",
+                 "slam.wheel_base_m=0.092", "slam.initial_pose=ground_truth"});
     // Position only: this log's motion-capture heading is off by 30°–180° for long stretches
     // (the staff SLAM's heading disagrees with it just as much), positions are fine.
     EXPECT_LE(Rmse(j, "slam_ate", "aligned", "x_m"), 0.03) << "seed " << seed;
@@ -80,9 +81,10 @@ TEST(SlamRegression, StationarySweepsStayWithinTwoCentimetres) {
   for (const char* log : {"sweep_convex_10mx10m_5cm", "sweep_convex_10mx10m_5cm_offcenter"}) {
     for (int seed : {1, 2, 3}) {
       // Filter updates forced on every scan (no motion threshold) so the filter has to hold the pose.
-      const std::string j = RunSlam("slam_replay.ini", std::string(log) + std::to_string(seed),
-                                {"pipeline.seed=" + std::to_string(seed), "source.path=" + Data(kLegacy + log + ".log"),
-                                 "slam.min_trans_m=0", "slam.min_rot_rad=0"});
+      const std::string j =
+          RunSlam("slam_replay.ini", std::string(log) + std::to_string(seed),
+                  {"pipeline.seed=" + std::to_string(seed), "source.path=" + Data(kLegacy + log + ".log"),
+                   "slam.min_trans_m=0", "slam.min_rot_rad=0"});
       EXPECT_GT(Get(j, {"filter_updates"}), 100);
       EXPECT_LE(Get(j, {"slam_ate", "aligned", "xy_m", "max"}), 0.02) << log << " seed " << seed;
       EXPECT_LE(Get(j, {"slam_ate", "aligned", "theta_deg", "max"}), 1.5) << log << " seed " << seed;
@@ -95,10 +97,10 @@ TEST(SlamRegression, LocalizationOnTheLegacyMaps) {
   EXPECT_LE(Rmse(j, "slam_ate", "unaligned", "xy_m"), 0.09);
   EXPECT_LE(Rmse(j, "slam_ate", "aligned", "x_m"), 0.05);
   for (const char* log : {"sweep_convex_10mx10m_5cm", "sweep_convex_10mx10m_5cm_offcenter"}) {
-    const std::string k = RunSlam("localization.ini", std::string("loc_") + log,
-                              {"source.path=" + Data(kLegacy + log + ".log"),
-                               "slam.map_file=" + Data(kLegacy + "maps/" + log + ".map"), "slam.min_trans_m=0",
-                               "slam.min_rot_rad=0"});
+    const std::string k = RunSlam(
+        "localization.ini", std::string("loc_") + log,
+        {"source.path=" + Data(kLegacy + log + ".log"), "slam.map_file=" + Data(kLegacy + "maps/" + log + ".map"),
+         "slam.min_trans_m=0", "slam.min_rot_rad=0"});
     EXPECT_LE(Get(k, {"slam_ate", "unaligned", "xy_m", "max"}), 0.02) << log;
   }
 }
@@ -113,7 +115,7 @@ TEST(SlamRegression, GlobalLocalizationOnDriveSquareConvergesAndSaysWhen) {
 TEST(SlamRegression, KidnappedRobotIsFlaggedLostAndRecovers) {
   for (int seed : {1, 2, 3}) {
     const std::string j = RunSlam("localization.ini", "kidnap" + std::to_string(seed),
-                              {"pipeline.seed=" + std::to_string(seed), "slam.kidnap_at_s=15"});
+                                  {"pipeline.seed=" + std::to_string(seed), "slam.kidnap_at_s=15"});
     ASSERT_NE(j.find("\"lost\": [{"), std::string::npos) << j;
     EXPECT_GE(Get(j, {"lost", "at_s"}), 15.0);
     EXPECT_LE(Get(j, {"lost", "scans_to_recover"}), 10);
@@ -129,11 +131,12 @@ TEST(SlamRegression, CarmenIntelMapFromCorrectedPosesThenLocalizationWithNoisyOd
   EXPECT_GT(Get(m, {"map", "scan_consistency"}), 0.95);
   const std::string map = ::testing::TempDir() + "/slam_intel_map/slam_map.map";
   ASSERT_TRUE(fs::exists(map));
-  const std::string j = RunSlam("localization.ini", "intel_loc",
-                            {"source.path=" + Data("carmen/intel-corrected.log.gz"), "slam.map_file=" + map,
-                             "slam.odometry_channel=FLASER.odom", "slam.truth=reference", "slam.initial_pose=reference",
-                             "slam.odometry_noise_trans=0.1", "slam.odometry_noise_rot=0.1", "slam.k1=0.05",
-                             "slam.k2=0.05", "slam.max_range_m=20", "slam.relocalize_when_lost=false"});
+  const std::string j =
+      RunSlam("localization.ini", "intel_loc",
+              {"source.path=" + Data("carmen/intel-corrected.log.gz"), "slam.map_file=" + map,
+               "slam.odometry_channel=FLASER.odom", "slam.truth=reference", "slam.initial_pose=reference",
+               "slam.odometry_noise_trans=0.1", "slam.odometry_noise_rot=0.1", "slam.k1=0.05", "slam.k2=0.05",
+               "slam.max_range_m=20", "slam.relocalize_when_lost=false"});
   EXPECT_GT(Rmse(j, "odometry_ate", "aligned", "xy_m"), 1.0);  // the noise really hurts odometry
   EXPECT_LE(Rmse(j, "slam_ate", "aligned", "xy_m"), 0.10);
 }
@@ -192,7 +195,8 @@ std::vector<TimedPose> MrptDemoTrack(const std::string& simplemap, const std::st
       pdf.getMean(mean);
       const auto cov = pdf.getCovariance();
       track.push_back({mrpt::Clock::toDouble(sf->getObservationByIndex(0)->timestamp),
-                       {mean.x(), mean.y(), mean.phi()}, std::sqrt(cov(0, 0) + cov(1, 1))});
+                       {mean.x(), mean.y(), mean.phi()},
+                       std::sqrt(cov(0, 0) + cov(1, 1))});
     }
   }
   return track;
@@ -223,8 +227,8 @@ struct DemoRun {
 DemoRun RunMrptDemo(const std::vector<TimedPose>& mrpt_track, int seed, const std::vector<std::string>& extra) {
   const std::string map = Data("mrpt/localization_demo.simplemap.gz"), log = Data("mrpt/localization_demo.rawlog");
   const std::string name = "mrpt_demo_" + std::to_string(seed) + (extra.empty() ? "" : "_hint");
-  std::vector<std::string> sets = {"pipeline.seed=" + std::to_string(seed), "source.path=" + log, "slam.map_file=" + map,
-                                   "slam.initial_pose=global"};
+  std::vector<std::string> sets = {"pipeline.seed=" + std::to_string(seed), "source.path=" + log,
+                                   "slam.map_file=" + map, "slam.initial_pose=global"};
   sets.insert(sets.end(), extra.begin(), extra.end());
   DemoRun r;
   r.converged = RunSlam("localization.ini", name, sets).find("\"converged\": true") != std::string::npos;
@@ -232,7 +236,9 @@ DemoRun RunMrptDemo(const std::vector<TimedPose>& mrpt_track, int seed, const st
   EXPECT_EQ(ours.size(), mrpt_track.size());
   std::ifstream csv(::testing::TempDir() + "/slam_" + name + "/slam_scans.csv");
   std::string line;
-  std::getline(csv, line);  // t_s,x,y,theta,filter_updated,particles,ess,spread_m,inlier_fraction,fit_ratio,injected,lost,converged,...
+  std::getline(
+      csv,
+      line);  // t_s,x,y,theta,filter_updated,particles,ess,spread_m,inlier_fraction,fit_ratio,injected,lost,converged,...
   for (size_t i = 0; std::getline(csv, line); ++i) {
     std::vector<std::string> f;
     std::stringstream row(line);

@@ -40,7 +40,7 @@ TEST(RefereeWarehouse, AMissedStopFailsItsDeliveryAndTheNextStillCounts) {
   h.Stand(stops[2].pose, 2.2);                                // on to delivery 2: drop-off 1 missed
   h.Stand(stops[3].pose, 1.0);                                // too short to count...
   h.Stand({0, 0, 0}, 0.01);
-  h.Stand(stops[3].pose, 2.2);                                // ...the second visit does
+  h.Stand(stops[3].pose, 2.2);  // ...the second visit does
   const Score s = h.referee().Judge();
   EXPECT_EQ(s.levels_reached, 1);
   ASSERT_EQ(s.stops.size(), 14u);

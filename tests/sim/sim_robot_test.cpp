@@ -350,11 +350,9 @@ TEST(SimSource, VelocityCommandsDriveTheRobot) {
   };
   ASSERT_TRUE(until(0.5));
   EXPECT_EQ(sim.robot().distance_travelled_m(), 0.0);
-  sink.Send(Event{500000, 500000, "MBOT_VEL_CMD", EventKind::kMotorCommand,
-                  MotorCommand::Velocity(0.2, 0.0)});
-  sink.Send(Event{500000, 500000, "MBOT_MOTOR_PWM", EventKind::kMotorCommand,
-                  MotorCommand::Pwm(0.0, 0.0)});  // ignored
-  sink.Send(Event{500000, 500000, "TRUE_POSE", EventKind::kGroundTruth, Pose2D{}});  // ignored
+  sink.Send(Event{500000, 500000, "MBOT_VEL_CMD", EventKind::kMotorCommand, MotorCommand::Velocity(0.2, 0.0)});
+  sink.Send(Event{500000, 500000, "MBOT_MOTOR_PWM", EventKind::kMotorCommand, MotorCommand::Pwm(0.0, 0.0)});  // ignored
+  sink.Send(Event{500000, 500000, "TRUE_POSE", EventKind::kGroundTruth, Pose2D{}});                           // ignored
   ASSERT_TRUE(until(2.5));
   EXPECT_GT(sim.robot().true_pose().x, -0.5 + 0.3);
   EXPECT_NEAR(sim.Progress(), 2.5 / 3.0, 0.01);
@@ -367,8 +365,9 @@ TEST(SimSource, VelocityCommandsDriveTheRobot) {
 TEST(SimSource, OptionsAreStrictAndOnlyForTheSimulator) {
   const std::string arena = WriteArena("room_opts.arena", kRoom);
   const std::string base = "[source]\ntype = sim\npath = " + arena + "\n";
-  const SourceOptions o = ParseSource(base + "start = 1, -0.5, 90\nlidar_beams = 720\nright_motor_gain = 0.9\n"
-                                             "firmware_rate_hz = 100\n");
+  const SourceOptions o = ParseSource(base +
+                                      "start = 1, -0.5, 90\nlidar_beams = 720\nright_motor_gain = 0.9\n"
+                                      "firmware_rate_hz = 100\n");
   const auto& so = std::any_cast<const SimSourceOptions&>(o.extra);
   ASSERT_TRUE(so.start.has_value());
   EXPECT_DOUBLE_EQ(so.start->x, 1.0);

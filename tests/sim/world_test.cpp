@@ -71,7 +71,8 @@ TEST(SimWorld, ParseErrorsNameTheLineAndToken) {
   EXPECT_EQ(ParseError("wall 0 0 inf 1\n"), "a.arena:1: 'wall': 'inf' is not a finite number");
   EXPECT_EQ(ParseError("wall 0 0 1 1\nwall 2 2 2 2  # a post?\n"), "a.arena:2: 'wall' has zero length");
   EXPECT_EQ(ParseError("box 0 0 0 1\n"), "a.arena:1: 'box' has zero width or height");
-  EXPECT_EQ(ParseError("resolution 0.001\nwall 0 0 1 1\n"), "a.arena:1: 'resolution' 0.001 out of range [0.005, 0.5] m");
+  EXPECT_EQ(ParseError("resolution 0.001\nwall 0 0 1 1\n"),
+            "a.arena:1: 'resolution' 0.001 out of range [0.005, 0.5] m");
   EXPECT_EQ(ParseError("resolution 0.05\nresolution 0.05\n"), "a.arena:2: 'resolution' given twice (first at line 1)");
   EXPECT_EQ(ParseError("thickness 0\n"), "a.arena:1: 'thickness' 0 out of range [0.001, 1] m");
   EXPECT_EQ(ParseError("thickness 0.02\nwall 0 0 1 0\nthickness 0.05\n"),
@@ -229,8 +230,7 @@ void ExpectClearanceAgreesWithRays(const World& w, double x, double y) {
 }
 
 TEST(SimWorld, ClearanceAndCollidesAgreeWithRaycast) {
-  const World arena = World::ParseArena(
-      "box 0 0 2 1.5\nwall 0.8 0.6 1.3 0.9\nwall 1.6 1.5 1.6 1.1\n", "a.arena");
+  const World arena = World::ParseArena("box 0 0 2 1.5\nwall 0.8 0.6 1.3 0.9\nwall 1.6 1.5 1.6 1.1\n", "a.arena");
   for (const auto& [x, y] : Scatter(0, 0, 2, 1.5, 0.03, 12)) {
     if (arena.ClearanceAt(x, y) > 1e-3) ExpectClearanceAgreesWithRays(arena, x, y);
   }
@@ -245,10 +245,10 @@ TEST(SimWorld, ClearanceAndCollidesAgreeWithRaycast) {
   for (const auto& [x, y] : Scatter(0.05, 0.05, 1.95, 1.45, 0.01, 12)) {
     if (g.ClearanceAt(x, y) > 1e-3) ExpectClearanceAgreesWithRays(g, x, y);
   }
-  EXPECT_NEAR(g.ClearanceAt(1.0, 0.8), std::hypot(0.0, 0.1), 1e-12);       // above the post's top
-  EXPECT_NEAR(g.ClearanceAt(0.9, 0.8), std::hypot(0.1, 0.1), 1e-12);       // diagonal to its corner
-  EXPECT_NEAR(g.ClearanceAt(1.5, 0.4), std::hypot(0.0, 0.35), 1e-12);      // the border
-  EXPECT_NEAR(g.ClearanceAt(1.6, 1.025), 0.05, 1e-12);                     // the unknown cell
+  EXPECT_NEAR(g.ClearanceAt(1.0, 0.8), std::hypot(0.0, 0.1), 1e-12);   // above the post's top
+  EXPECT_NEAR(g.ClearanceAt(0.9, 0.8), std::hypot(0.1, 0.1), 1e-12);   // diagonal to its corner
+  EXPECT_NEAR(g.ClearanceAt(1.5, 0.4), std::hypot(0.0, 0.35), 1e-12);  // the border
+  EXPECT_NEAR(g.ClearanceAt(1.6, 1.025), 0.05, 1e-12);                 // the unknown cell
 }
 
 TEST(SimWorld, GridWorldCountsUnknownAsWall) {
@@ -310,7 +310,8 @@ TEST(SimWorld, LoadsArenaAndMapFilesAndNamesTheFileInErrors) {
     World::Load(arena_path);
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
-    EXPECT_EQ(std::string(e.what()), arena_path + ":3: unknown statement 'bogus' (known: name, resolution, thickness, wall, box, pose)");
+    EXPECT_EQ(std::string(e.what()),
+              arena_path + ":3: unknown statement 'bogus' (known: name, resolution, thickness, wall, box, pose)");
   }
   std::ofstream(arena_path) << "box 0 0 2 1\npose start 0.5 0.5 0\n";
   const World a = World::Load(arena_path);
@@ -379,7 +380,8 @@ std::vector<std::string> ShippedArenas() {
 TEST(SimArenas, EveryShippedArenaIsEnclosedAndItsPosesReachable) {
   const auto paths = ShippedArenas();
   for (const char* name : {"convex_circuit", "maze_1", "maze_2", "maze_3", "warehouse"}) {
-    EXPECT_TRUE(std::count(paths.begin(), paths.end(), std::string(MBOT_SOURCE_DIR) + "/datasets/arenas/" + name + ".arena"))
+    EXPECT_TRUE(
+        std::count(paths.begin(), paths.end(), std::string(MBOT_SOURCE_DIR) + "/datasets/arenas/" + name + ".arena"))
         << name;
   }
   for (const auto& path : paths) {
@@ -396,7 +398,8 @@ TEST(SimArenas, EveryShippedArenaIsEnclosedAndItsPosesReachable) {
       int cx, cy;
       w.truth().WorldToCell(p.pose.x, p.pose.y, &cx, &cy);
       ASSERT_TRUE(w.truth().IsInside(cx, cy));
-      EXPECT_TRUE(mask[static_cast<size_t>(cy) * w.truth().width() + cx]) << p.label << " " << p.pose.x << " " << p.pose.y;
+      EXPECT_TRUE(mask[static_cast<size_t>(cy) * w.truth().width() + cx])
+          << p.label << " " << p.pose.x << " " << p.pose.y;
     }
     const std::string stem = std::filesystem::path(path).stem().string();
     const double area = std::count(mask.begin(), mask.end(), 1) * std::pow(w.truth().resolution(), 2);

@@ -82,8 +82,8 @@ class ActionModelFitStage : public Stage {
     const double z = 1.959964;
     std::ostringstream t;
     t << "action model fit: " << odo.size() << " paired samples (" << odometry_.size() - odo.size()
-      << " without ground truth), windows of " << o_.fit.window_steps << " samples: " << fit.windows_used
-      << " used, " << fit.windows_skipped << " skipped\n";
+      << " without ground truth), windows of " << o_.fit.window_steps << " samples: " << fit.windows_used << " used, "
+      << fit.windows_skipped << " skipped\n";
     t << std::setprecision(3);
     t << "  k1 (rotation)    " << std::setw(10) << fit.k1 << "  +- " << fit.k1_std << " (1 sigma)   rad^2/rad\n";
     t << "  k2 (translation) " << std::setw(10) << fit.k2 << "  +- " << fit.k2_std << " (1 sigma)   m^2/m\n";
@@ -93,18 +93,20 @@ class ActionModelFitStage : public Stage {
     std::cout << t.str() << std::flush;
 
     std::ostringstream j;
-    j << "{\n  \"source\": " << JsonString(ctx.source_path) << ",\n  \"interrupted\": " << (interrupted ? "true" : "false")
+    j << "{\n  \"source\": " << JsonString(ctx.source_path)
+      << ",\n  \"interrupted\": " << (interrupted ? "true" : "false")
       << ",\n  \"odometry\": " << JsonString(o_.encoder_odometry ? "encoders" : o_.odometry_channel)
       << ",\n  \"paired_samples\": " << odo.size() << ",\n  \"unpaired_samples\": " << odometry_.size() - odo.size()
       << ",\n  \"window_steps\": " << o_.fit.window_steps << ",\n  \"windows_used\": " << fit.windows_used
-      << ",\n  \"windows_skipped\": " << fit.windows_skipped << ",\n  \"converged\": " << (fit.converged ? "true" : "false")
-      << ",\n  \"message\": " << JsonString(fit.message) << ",\n  \"nll\": " << Num(fit.nll)
-      << ",\n  \"k1\": " << Num(fit.k1) << ", \"k1_std\": " << Num(fit.k1_std) << ", \"k1_95\": [" << Num(std::max(0.0, fit.k1 - z * fit.k1_std))
-      << ", " << Num(fit.k1 + z * fit.k1_std) << "]"
-      << ",\n  \"k2\": " << Num(fit.k2) << ", \"k2_std\": " << Num(fit.k2_std) << ", \"k2_95\": [" << Num(std::max(0.0, fit.k2 - z * fit.k2_std))
-      << ", " << Num(fit.k2 + z * fit.k2_std) << "]"
-      << ",\n  \"reports\": [{\"k1\": " << kReportK[0][0] << ", \"k2\": " << kReportK[0][1] << ", \"from\": \"seed report\"}, {\"k1\": "
-      << kReportK[1][0] << ", \"k2\": " << kReportK[1][1] << ", \"from\": \"second report\"}]\n}\n";
+      << ",\n  \"windows_skipped\": " << fit.windows_skipped
+      << ",\n  \"converged\": " << (fit.converged ? "true" : "false") << ",\n  \"message\": " << JsonString(fit.message)
+      << ",\n  \"nll\": " << Num(fit.nll) << ",\n  \"k1\": " << Num(fit.k1) << ", \"k1_std\": " << Num(fit.k1_std)
+      << ", \"k1_95\": [" << Num(std::max(0.0, fit.k1 - z * fit.k1_std)) << ", " << Num(fit.k1 + z * fit.k1_std) << "]"
+      << ",\n  \"k2\": " << Num(fit.k2) << ", \"k2_std\": " << Num(fit.k2_std) << ", \"k2_95\": ["
+      << Num(std::max(0.0, fit.k2 - z * fit.k2_std)) << ", " << Num(fit.k2 + z * fit.k2_std) << "]"
+      << ",\n  \"reports\": [{\"k1\": " << kReportK[0][0] << ", \"k2\": " << kReportK[0][1]
+      << ", \"from\": \"seed report\"}, {\"k1\": " << kReportK[1][0] << ", \"k2\": " << kReportK[1][1]
+      << ", \"from\": \"second report\"}]\n}\n";
     WriteFileAtomically(ctx.output_dir + "/action_model_fit.json", [&](std::ostream& out) { out << j.str(); });
     if (!fit.converged) {
       if (interrupted) return;
@@ -113,8 +115,8 @@ class ActionModelFitStage : public Stage {
     }
     WriteFileAtomically(ctx.output_dir + "/action_model.ini", [&](std::ostream& out) {
       out << "# Action-model noise fitted by mbot_nav (action_model_fit stage) from\n# " << ctx.source_path << "\n# "
-          << fit.windows_used << " windows of " << o_.fit.window_steps << " odometry samples; 1 sigma: k1 +- " << fit.k1_std
-          << ", k2 +- " << fit.k2_std << "\n[" << o_.snippet_section << "]\n"
+          << fit.windows_used << " windows of " << o_.fit.window_steps << " odometry samples; 1 sigma: k1 +- "
+          << fit.k1_std << ", k2 +- " << fit.k2_std << "\n[" << o_.snippet_section << "]\n"
           << std::setprecision(6) << "k1 = " << fit.k1 << "\nk2 = " << fit.k2 << "\n";
     });
     mbot::log::Info("action_model_fit: wrote action_model.ini and action_model_fit.json in " + ctx.output_dir);
@@ -142,8 +144,10 @@ class ActionModelFitStage : public Stage {
       max_delay = std::max(max_delay, (odometry_[i].t_us - stamps_[i] - offset) * 1e-6);
       odometry_[i].t_us = stamps_[i] + offset;
     }
-    std::sort(odometry_.begin(), odometry_.end(), [](const TimedPose& a, const TimedPose& b) { return a.t_us < b.t_us; });
-    mbot::log::Info("action_model_fit: odometry placed by its stamps; the log delayed it by up to " + Num(max_delay, 3) + " s");
+    std::sort(odometry_.begin(), odometry_.end(),
+              [](const TimedPose& a, const TimedPose& b) { return a.t_us < b.t_us; });
+    mbot::log::Info("action_model_fit: odometry placed by its stamps; the log delayed it by up to " +
+                    Num(max_delay, 3) + " s");
   }
 
   ActionModelFitStageOptions o_;
@@ -155,29 +159,39 @@ class ActionModelFitStage : public Stage {
 }  // namespace
 
 StageType ActionModelFitStageType() {
-  return {"action_model_fit",
-          "maximum-likelihood fit of the action model's k1, k2 from odometry against ground truth; writes an INI snippet "
-          "and a report with confidence intervals",
-          [](config::Section& s) -> std::unique_ptr<Stage> {
-            ActionModelFitStageOptions o;
-            auto& f = o.fit;
-            f.window_steps = static_cast<int>(s.GetInt("window_steps", f.window_steps,
-                                                       "odometry samples per window (one filter update; 10 at 50 Hz = one 5 Hz scan)", 1));
-            f.min_sigma_rot_rad = s.GetDouble("min_sigma_rot_rad", f.min_sigma_rot_rad, "rotation noise floor of the model (fixed) [rad]", 0.0);
-            f.min_sigma_trans_m = s.GetDouble("min_sigma_trans_m", f.min_sigma_trans_m, "translation noise floor of the model (fixed) [m]", 0.0);
-            f.min_trans_m = s.GetDouble("min_trans_m", f.min_trans_m, "windows moving less (and turning less than min_rot_rad) are skipped [m]", 0.0);
-            f.min_rot_rad = s.GetDouble("min_rot_rad", f.min_rot_rad, "see min_trans_m [rad]", 0.0);
-            f.warn_below_windows = static_cast<int>(s.GetInt("warn_below_windows", f.warn_below_windows, "fewer windows are flagged as a rough fit", 1));
-            o.encoder_odometry = s.GetChoice("odometry", "channel", {"channel", "encoders"},
-                                             "odometry from an odometry channel or integrated from encoder ticks") == "encoders";
-            o.odometry_channel = s.GetString("odometry_channel", "", "odometry channel ('' = the first one seen)");
-            o.wheels = motion::ParseWheelConstants(s);
-            o.max_truth_gap_s = s.GetDouble("max_truth_gap_s", o.max_truth_gap_s, "ground truth is interpolated across gaps up to this [s]", 0.0);
-            o.odometry_on_stamps = s.GetChoice("clock", "event", {"event", "stamp"},
-                                               "place odometry by when it was logged (as the ground truth) or by its own stamps (offset to the log clock)") == "stamp";
-            o.snippet_section = s.GetString("snippet_section", o.snippet_section, "section name written in action_model.ini");
-            return std::make_unique<ActionModelFitStage>(o);
-          }};
+  return {
+      "action_model_fit",
+      "maximum-likelihood fit of the action model's k1, k2 from odometry against ground truth; writes an INI snippet "
+      "and a report with confidence intervals",
+      [](config::Section& s) -> std::unique_ptr<Stage> {
+        ActionModelFitStageOptions o;
+        auto& f = o.fit;
+        f.window_steps = static_cast<int>(
+            s.GetInt("window_steps", f.window_steps,
+                     "odometry samples per window (one filter update; 10 at 50 Hz = one 5 Hz scan)", 1));
+        f.min_sigma_rot_rad = s.GetDouble("min_sigma_rot_rad", f.min_sigma_rot_rad,
+                                          "rotation noise floor of the model (fixed) [rad]", 0.0);
+        f.min_sigma_trans_m = s.GetDouble("min_sigma_trans_m", f.min_sigma_trans_m,
+                                          "translation noise floor of the model (fixed) [m]", 0.0);
+        f.min_trans_m = s.GetDouble("min_trans_m", f.min_trans_m,
+                                    "windows moving less (and turning less than min_rot_rad) are skipped [m]", 0.0);
+        f.min_rot_rad = s.GetDouble("min_rot_rad", f.min_rot_rad, "see min_trans_m [rad]", 0.0);
+        f.warn_below_windows = static_cast<int>(
+            s.GetInt("warn_below_windows", f.warn_below_windows, "fewer windows are flagged as a rough fit", 1));
+        o.encoder_odometry =
+            s.GetChoice("odometry", "channel", {"channel", "encoders"},
+                        "odometry from an odometry channel or integrated from encoder ticks") == "encoders";
+        o.odometry_channel = s.GetString("odometry_channel", "", "odometry channel ('' = the first one seen)");
+        o.wheels = motion::ParseWheelConstants(s);
+        o.max_truth_gap_s = s.GetDouble("max_truth_gap_s", o.max_truth_gap_s,
+                                        "ground truth is interpolated across gaps up to this [s]", 0.0);
+        o.odometry_on_stamps = s.GetChoice("clock", "event", {"event", "stamp"},
+                                           "place odometry by when it was logged (as the ground truth) or by its own "
+                                           "stamps (offset to the log clock)") == "stamp";
+        o.snippet_section =
+            s.GetString("snippet_section", o.snippet_section, "section name written in action_model.ini");
+        return std::make_unique<ActionModelFitStage>(o);
+      }};
 }
 
 }  // namespace mbot::app

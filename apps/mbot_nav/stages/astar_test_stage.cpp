@@ -143,7 +143,8 @@ class AStarTestStage : public Stage {
     table << line;
     std::vector<std::string> failed_maps;
     std::ostringstream json;
-    json << "{\n  \"repeats\": " << options_.repeats << ",\n  \"robot_radius_m\": " << Num(options_.astar.robot_radius_m)
+    json << "{\n  \"repeats\": " << options_.repeats
+         << ",\n  \"robot_radius_m\": " << Num(options_.astar.robot_radius_m)
          << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"maps\": [";
     for (size_t i = 0; i < reports_.size(); ++i) {
       const MapReport& r = reports_[i];
@@ -156,8 +157,8 @@ class AStarTestStage : public Stage {
                     r.passed() ? "PASSED" : "FAILED", cases.c_str(), "success", ok.count, ok.min, ok.mean, ok.median,
                     ok.max, ok.std);
       table << line;
-      std::snprintf(line, sizeof line, "%-10s %-7s %6s  %-9s %6zu %8.1f %8.1f %8.1f %8.1f %8.1f\n", "", "", "", "failed",
-                    bad.count, bad.min, bad.mean, bad.median, bad.max, bad.std);
+      std::snprintf(line, sizeof line, "%-10s %-7s %6s  %-9s %6zu %8.1f %8.1f %8.1f %8.1f %8.1f\n", "", "", "",
+                    "failed", bad.count, bad.min, bad.mean, bad.median, bad.max, bad.std);
       table << line;
       for (const auto& c : r.cases) {
         if (c.passed) continue;
@@ -165,10 +166,11 @@ class AStarTestStage : public Stage {
                       r.name.c_str(), c.index, c.expected ? "a path" : "no path", c.status.c_str(), c.found, c.valid);
         table << line;
       }
-      json << (i ? "," : "") << "\n    {\"name\": " << JsonString(r.name) << ", \"passed\": " << (r.passed() ? "true" : "false")
-           << ", \"size\": [" << r.width << ", " << r.height << "], \"resolution_m\": " << Num(r.resolution)
-           << ", \"distance_build_us\": " << Num(r.distance_build_us) << ", \"planner_setup_us\": " << Num(r.planner_setup_us)
-           << ",\n     \"success_us\": " << ok.Json() << ",\n     \"failure_us\": " << bad.Json() << ",\n     \"cases\": [";
+      json << (i ? "," : "") << "\n    {\"name\": " << JsonString(r.name)
+           << ", \"passed\": " << (r.passed() ? "true" : "false") << ", \"size\": [" << r.width << ", " << r.height
+           << "], \"resolution_m\": " << Num(r.resolution) << ", \"distance_build_us\": " << Num(r.distance_build_us)
+           << ", \"planner_setup_us\": " << Num(r.planner_setup_us) << ",\n     \"success_us\": " << ok.Json()
+           << ",\n     \"failure_us\": " << bad.Json() << ",\n     \"cases\": [";
       for (size_t k = 0; k < r.cases.size(); ++k) {
         const auto& c = r.cases[k];
         json << (k ? ", " : "") << "{\"index\": " << c.index << ", \"expected\": " << (c.expected ? "true" : "false")
@@ -210,7 +212,8 @@ StageType AStarTestStageType() {
           "PASSED/FAILED per map and planning-time statistics",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             AStarTestOptions o;
-            o.repeats = static_cast<int>(s.GetInt("repeats", o.repeats, "planning calls per case (timed each)", 1, 100000));
+            o.repeats =
+                static_cast<int>(s.GetInt("repeats", o.repeats, "planning calls per case (timed each)", 1, 100000));
             o.json_file = s.GetString("json_file", o.json_file, "report file in output.dir");
             o.astar = planning::ParseAStarOptions(s);
             o.distance = planning::ParseObstacleDistanceOptions(s);

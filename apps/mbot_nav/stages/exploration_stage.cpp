@@ -63,7 +63,8 @@ class ExplorationStage : public Stage {
         out << (i ? ",\n  " : "\n  ") << "{\"t\": " << Num(d.t_s, 12) << ", \"state\": " << JsonString(d.state)
             << ", \"reason\": " << JsonString(d.reason) << ", \"path\": [";
         for (size_t k = 0; k < d.path.size(); ++k) {
-          out << (k ? ", " : "") << "[" << Num(d.path[k].x) << ", " << Num(d.path[k].y) << ", " << Num(d.path[k].theta) << "]";
+          out << (k ? ", " : "") << "[" << Num(d.path[k].x) << ", " << Num(d.path[k].y) << ", " << Num(d.path[k].theta)
+              << "]";
         }
         out << "]}";
       }
@@ -94,8 +95,9 @@ StageType ExplorationStageType() {
           "runs the frontier-exploration state machine on the stream's maps and poses and records its paths and states",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             ExplorationStageOptions o;
-            const std::string pose = s.GetChoice("pose", "reference_pose", {"reference_pose", "ground_truth", "odometry"},
-                                                 "which pose stream is the robot's pose (SLAM output is reference_pose)");
+            const std::string pose =
+                s.GetChoice("pose", "reference_pose", {"reference_pose", "ground_truth", "odometry"},
+                            "which pose stream is the robot's pose (SLAM output is reference_pose)");
             o.pose_kind = pose == "ground_truth" ? drivers::EventKind::kGroundTruth
                           : pose == "odometry"   ? drivers::EventKind::kOdometry
                                                  : drivers::EventKind::kReferencePose;

@@ -80,8 +80,10 @@ class InspectStage : public Stage {
       }
       if (!d.empty()) c.spacing_deg.push_back(Median(d));
     } else if (const auto* pose = std::get_if<motion::Pose2D>(&ev.payload)) {
-      if (c.count == 1) c.first_pose = *pose;
-      else c.path_m += std::hypot(pose->x - c.last_pose.x, pose->y - c.last_pose.y);
+      if (c.count == 1)
+        c.first_pose = *pose;
+      else
+        c.path_m += std::hypot(pose->x - c.last_pose.x, pose->y - c.last_pose.y);
       c.last_pose = *pose;
     } else if (const auto* map = std::get_if<std::shared_ptr<const mapping::OccupancyGrid>>(&ev.payload)) {
       c.map = *map;
@@ -99,20 +101,23 @@ class InspectStage : public Stage {
     for (const auto& [k, v] : src.Details()) text << "  " << k << ": " << v << "\n";
     text << "events:       " << events_ << (interrupted ? " (interrupted)" : "") << "\n"
          << "time span:    " << std::fixed << std::setprecision(3) << span << " s\n"
-         << "event time:   " << (backwards_ == 0 ? "monotonic" : std::to_string(backwards_) + " steps backwards") << "\n"
+         << "event time:   " << (backwards_ == 0 ? "monotonic" : std::to_string(backwards_) + " steps backwards")
+         << "\n"
          << "ground truth: " << (ground_truth ? "yes" : "no") << "\n";
     const auto& d = src.diagnostics();
     text << "problems:     " << d.rejected_messages << " rejected, " << d.unknown_messages << " of unknown type, "
          << d.resyncs << " resyncs (" << d.skipped_bytes << " bytes skipped)"
          << (d.truncated_tail ? ", truncated tail" : "") << "\n\n";
     text << std::left << std::setw(24) << "channel" << std::setw(34) << "type" << std::setw(30) << "generation"
-         << std::setw(15) << "role" << std::right << std::setw(8) << "count" << std::setw(10) << "rate Hz" << "\n";
+         << std::setw(15) << "role" << std::right << std::setw(8) << "count" << std::setw(10) << "rate Hz"
+         << "\n";
     json << "{\n  \"dataset\": " << JsonString(ctx.source_path) << ",\n  \"format\": " << JsonString(src.Format())
          << ",\n  \"events\": " << events_ << ",\n  \"interrupted\": " << (interrupted ? "true" : "false")
          << ",\n  \"time_span_s\": " << Num(span, 9) << ",\n  \"event_time_backwards_steps\": " << backwards_
-         << ",\n  \"ground_truth\": " << (ground_truth ? "true" : "false") << ",\n  \"rejected_messages\": "
-         << d.rejected_messages << ",\n  \"unknown_messages\": " << d.unknown_messages << ",\n  \"resyncs\": " << d.resyncs
-         << ",\n  \"truncated_tail\": " << (d.truncated_tail ? "true" : "false") << ",\n  \"details\": {";
+         << ",\n  \"ground_truth\": " << (ground_truth ? "true" : "false")
+         << ",\n  \"rejected_messages\": " << d.rejected_messages << ",\n  \"unknown_messages\": " << d.unknown_messages
+         << ",\n  \"resyncs\": " << d.resyncs << ",\n  \"truncated_tail\": " << (d.truncated_tail ? "true" : "false")
+         << ",\n  \"details\": {";
     bool first = true;
     for (const auto& [k, v] : src.Details()) {
       json << (first ? "" : ", ") << JsonString(k) << ": " << JsonString(v);
@@ -132,10 +137,11 @@ class InspectStage : public Stage {
            << (info.decoded ? drivers::ToString(info.kind) : "skipped") << std::right << std::setw(8) << c.count
            << std::setw(10) << (std::isfinite(rate) ? Num(rate, 4) : "-") << "\n";
       json << (first ? "" : ",") << "\n    " << JsonString(name) << ": {\"type\": " << JsonString(info.type)
-           << ", \"generation\": " << JsonString(info.generation) << ", \"role\": "
-           << JsonString(info.decoded ? drivers::ToString(info.kind) : "skipped") << ", \"count\": " << c.count
-           << ", \"rate_hz\": " << Num(rate) << ", \"first_s\": " << Num(c.first_us * 1e-6, 16)
-           << ", \"last_s\": " << Num(c.last_us * 1e-6, 16) << ", \"backwards_steps\": " << c.backwards;
+           << ", \"generation\": " << JsonString(info.generation)
+           << ", \"role\": " << JsonString(info.decoded ? drivers::ToString(info.kind) : "skipped")
+           << ", \"count\": " << c.count << ", \"rate_hz\": " << Num(rate)
+           << ", \"first_s\": " << Num(c.first_us * 1e-6, 16) << ", \"last_s\": " << Num(c.last_us * 1e-6, 16)
+           << ", \"backwards_steps\": " << c.backwards;
       first = false;
       if (c.beams_max > 0) {
         const double spacing = Median(c.spacing_deg);

@@ -17,7 +17,8 @@ namespace {
 
 struct BridgeOptions {
   std::string url = drivers::kDefaultLcmUrl;
-  std::vector<std::string> publish = {"LIDAR", "MBOT_ODOMETRY", "MBOT_ENCODERS", "MBOT_IMU", "MBOT_MOTOR_PWM", "MBOT_MOTOR_VEL"};
+  std::vector<std::string> publish = {"LIDAR",    "MBOT_ODOMETRY",  "MBOT_ENCODERS",
+                                      "MBOT_IMU", "MBOT_MOTOR_PWM", "MBOT_MOTOR_VEL"};
   std::vector<std::string> subscribe = {"MBOT_VEL_CMD"};
 };
 
@@ -51,7 +52,8 @@ class LcmBridgeStage : public Stage {
     std::string counts;
     for (const auto& [channel, s] : node_->stats()) {
       counts += (counts.empty() ? "" : ", ") + channel + " " + std::to_string(s.received) + " in / " +
-                std::to_string(s.published) + " out" + (s.rejected + s.unknown ? " / " + std::to_string(s.rejected + s.unknown) + " rejected" : "");
+                std::to_string(s.published) + " out" +
+                (s.rejected + s.unknown ? " / " + std::to_string(s.rejected + s.unknown) + " rejected" : "");
     }
     mbot::log::Info("lcm_bridge: " + counts);
   }
@@ -66,16 +68,18 @@ class LcmBridgeStage : public Stage {
 }  // namespace
 
 StageType LcmBridgeStageType() {
-  return {"lcm_bridge",
-          "the robot's side of the LCM bus: publishes the events it sees on `publish` channels as the botlab's messages, "
-          "and emits the validated messages arriving on `subscribe` channels (velocity commands to the simulator)",
-          [](config::Section& s) -> std::unique_ptr<Stage> {
-            BridgeOptions o;
-            o.url = s.GetString("url", o.url, "the LCM URL (ttl=0 keeps the traffic on this machine)");
-            o.publish = s.GetList("publish", o.publish, "channels published (what the robot's firmware and lidar driver publish)");
-            o.subscribe = s.GetList("subscribe", o.subscribe, "channels listened to (the autonomy's commands and outputs)");
-            return std::make_unique<LcmBridgeStage>(o);
-          }};
+  return {
+      "lcm_bridge",
+      "the robot's side of the LCM bus: publishes the events it sees on `publish` channels as the botlab's messages, "
+      "and emits the validated messages arriving on `subscribe` channels (velocity commands to the simulator)",
+      [](config::Section& s) -> std::unique_ptr<Stage> {
+        BridgeOptions o;
+        o.url = s.GetString("url", o.url, "the LCM URL (ttl=0 keeps the traffic on this machine)");
+        o.publish =
+            s.GetList("publish", o.publish, "channels published (what the robot's firmware and lidar driver publish)");
+        o.subscribe = s.GetList("subscribe", o.subscribe, "channels listened to (the autonomy's commands and outputs)");
+        return std::make_unique<LcmBridgeStage>(o);
+      }};
 }
 
 }  // namespace mbot::app

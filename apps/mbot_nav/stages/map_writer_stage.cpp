@@ -29,7 +29,8 @@ class MapWriterStage : public Stage {
   void Finish(const RunContext& ctx, bool /*interrupted*/) override {
     if (!map_) {
       mbot::log::Warn("map_writer: the input had no map" +
-                      (options_.channel.empty() ? std::string() : " on channel " + options_.channel) + "; nothing written");
+                      (options_.channel.empty() ? std::string() : " on channel " + options_.channel) +
+                      "; nothing written");
       return;
     }
     const std::string base = ctx.output_dir + "/" + options_.basename;

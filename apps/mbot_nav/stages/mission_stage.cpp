@@ -52,11 +52,14 @@ class MissionStage : public Stage {
   void Finish(const RunContext& ctx, bool interrupted) override {
     const mission::MissionReport r = mission_->Report();
     std::ostringstream j;
-    j << "{\n  \"task\": " << JsonString(mission::ToString(r.task)) << ",\n  \"state\": " << JsonString(ToString(r.status.state))
-      << ",\n  \"detail\": " << JsonString(r.status.detail) << ",\n  \"interrupted\": " << (interrupted ? "true" : "false")
-      << ",\n  \"commands\": " << r.commands << ",\n  \"paths\": " << r.paths << ",\n  \"stale_pose_stops\": " << r.stale_pose_stops
+    j << "{\n  \"task\": " << JsonString(mission::ToString(r.task))
+      << ",\n  \"state\": " << JsonString(ToString(r.status.state))
+      << ",\n  \"detail\": " << JsonString(r.status.detail)
+      << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"commands\": " << r.commands
+      << ",\n  \"paths\": " << r.paths << ",\n  \"stale_pose_stops\": " << r.stale_pose_stops
       << ",\n  \"corrections\": " << r.corrections << ",\n  \"stall_recoveries\": " << r.stall_recoveries;
-    if (r.task == mission::TaskKind::kWarehouse) j << ",\n  \"stops\": " << r.stops << ",\n  \"stops_done\": " << r.stops_done;
+    if (r.task == mission::TaskKind::kWarehouse)
+      j << ",\n  \"stops\": " << r.stops << ",\n  \"stops_done\": " << r.stops_done;
     j << "\n}\n";
     WriteFileAtomically(ctx.output_dir + "/mission.json", [&](std::ostream& out) { out << j.str(); });
   }

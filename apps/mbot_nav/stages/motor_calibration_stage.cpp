@@ -31,7 +31,7 @@ using motion::MotorSample;
 
 struct MotorCalibrationStageOptions {
   motion::MotorFitOptions fit;
-  motion::RobotGeometry geometry;  // encoder-derived speeds
+  motion::RobotGeometry geometry;   // encoder-derived speeds
   std::string speed_from = "auto";  // auto | wheel_speed | encoders
   double settle_s = 0.3;
   double duty_tolerance = 0.005;
@@ -145,7 +145,8 @@ class MotorCalibrationStage : public Stage {
         t << std::setw(14) << std::fixed << std::setprecision(5) << f.line.slope << std::setw(20) << f.line.punch
           << std::setw(10) << f.samples << std::setw(15) << std::setprecision(4) << f.residual_rms << "\n";
       } else {
-        t << std::setw(14) << "-" << std::setw(20) << "-" << std::setw(10) << f.samples << std::setw(15) << "-" << "\n";
+        t << std::setw(14) << "-" << std::setw(20) << "-" << std::setw(10) << f.samples << std::setw(15) << "-"
+          << "\n";
       }
     };
     row("left", "forward", r.left.forward);
@@ -167,17 +168,18 @@ class MotorCalibrationStage : public Stage {
                  const std::vector<MotorSample>* s, const RunContext& ctx, bool interrupted) const {
     std::ostringstream j;
     j << "{\n  \"source\": " << JsonString(ctx.source_path) << ",\n  \"samples_from\": " << JsonString(origin)
-      << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"acceptable\": "
-      << (r.acceptable ? "true" : "false") << ",\n  \"problems\": [";
+      << ",\n  \"interrupted\": " << (interrupted ? "true" : "false")
+      << ",\n  \"acceptable\": " << (r.acceptable ? "true" : "false") << ",\n  \"problems\": [";
     for (size_t i = 0; i < r.problems.size(); ++i) j << (i ? ", " : "") << JsonString(r.problems[i]);
-    j << "],\n  \"limits\": {\"max_abs_slope\": " << Num(o_.fit.max_abs_slope) << ", \"max_abs_punch\": "
-      << Num(o_.fit.max_abs_punch) << "}";
+    j << "],\n  \"limits\": {\"max_abs_slope\": " << Num(o_.fit.max_abs_slope)
+      << ", \"max_abs_punch\": " << Num(o_.fit.max_abs_punch) << "}";
     const auto wheel = [&](const char* name, const motion::WheelFit& w, const motion::WheelCalibration& c, size_t n) {
       j << ",\n  \"" << name << "\": {\"samples\": " << n << ", \"moving_samples\": " << w.moving_samples
-        << ", \"disagreeing_samples\": " << w.disagreeing_samples << ", \"encoder_counting\": "
-        << (w.encoder_counting ? "true" : "false") << ", \"polarity_ok\": " << (w.polarity_ok ? "true" : "false")
-        << ", \"motor_polarity\": " << c.motor_polarity << ", \"encoder_polarity\": " << c.encoder_polarity
-        << ",\n    \"forward\": " << LineJson(w.forward) << ",\n    \"backward\": " << LineJson(w.backward) << "}";
+        << ", \"disagreeing_samples\": " << w.disagreeing_samples
+        << ", \"encoder_counting\": " << (w.encoder_counting ? "true" : "false")
+        << ", \"polarity_ok\": " << (w.polarity_ok ? "true" : "false") << ", \"motor_polarity\": " << c.motor_polarity
+        << ", \"encoder_polarity\": " << c.encoder_polarity << ",\n    \"forward\": " << LineJson(w.forward)
+        << ",\n    \"backward\": " << LineJson(w.backward) << "}";
     };
     wheel("left", r.left, r.calibration.left, s[0].size());
     wheel("right", r.right, r.calibration.right, s[1].size());
@@ -189,7 +191,8 @@ class MotorCalibrationStage : public Stage {
                     const RunContext& ctx) const {
     WriteFileAtomically(path, [&](std::ostream& out) {
       out << "# Motor calibration fitted by mbot_nav (motor_calibration stage) from " << origin << " of\n# "
-          << ctx.source_path << "\n# duty = slope * wheel_speed[rad/s] + punch, per wheel and direction, in the wheel's\n"
+          << ctx.source_path
+          << "\n# duty = slope * wheel_speed[rad/s] + punch, per wheel and direction, in the wheel's\n"
           << "# forward frame; include it from a config whose [" << o_.snippet_section << "] reads these keys.\n"
           << "[" << o_.snippet_section << "]\n";
       const auto wheel = [&](const char* name, const motion::WheelCalibration& c) {
@@ -224,7 +227,8 @@ class MotorCalibrationStage : public Stage {
     const motion::WheelCalibration* cal[2] = {&r.calibration.left, &r.calibration.right};
     const motion::WheelFit* fits[2] = {&r.left, &r.right};
     for (int w = 0; w < 2; ++w) {
-      drivers::PlotSeries pts{{}, {}, colours[w][0], colours[w][1], colours[w][2], true, std::string(names[w]) + " samples"};
+      drivers::PlotSeries pts{
+          {}, {}, colours[w][0], colours[w][1], colours[w][2], true, std::string(names[w]) + " samples"};
       double lo = 0, hi = 0;
       for (const MotorSample& m : s[w]) {
         const double speed = cal[w]->encoder_polarity * m.speed_rad_s, duty = cal[w]->motor_polarity * m.duty;
@@ -234,14 +238,20 @@ class MotorCalibrationStage : public Stage {
       series.push_back(std::move(pts));
       for (const auto& [f, a, b] : {std::tuple{&fits[w]->forward, 0.0, hi}, std::tuple{&fits[w]->backward, lo, 0.0}}) {
         if (!f->fitted || a == b) continue;
-        series.push_back({{a, b}, {f->line.slope * a + f->line.punch, f->line.slope * b + f->line.punch},
-                          colours[w][0], colours[w][1], colours[w][2], false, ""});
+        series.push_back({{a, b},
+                          {f->line.slope * a + f->line.punch, f->line.slope * b + f->line.punch},
+                          colours[w][0],
+                          colours[w][1],
+                          colours[w][2],
+                          false,
+                          ""});
       }
     }
     series[0].label += " (lines: fit)";
-    drivers::WritePlotPng(series, {"motor calibration: duty = slope * speed + punch", "wheel speed [rad/s], forward frame",
-                                   "duty", 900, 600},
-                          path);
+    drivers::WritePlotPng(
+        series,
+        {"motor calibration: duty = slope * speed + punch", "wheel speed [rad/s], forward frame", "duty", 900, 600},
+        path);
   }
 
   MotorCalibrationStageOptions o_;
@@ -261,35 +271,55 @@ int Polarity(config::Section& s, const std::string& key, const std::string& doc)
 }  // namespace
 
 StageType MotorCalibrationStageType() {
-  return {"motor_calibration",
-          "fits the motor model (slope, punch per wheel and direction) from calibration samples or a log's PWM and "
-          "wheel speeds; writes an INI snippet, the CHANNEL,DIRECTION,M,B CSV, a plot and a report",
-          [](config::Section& s) -> std::unique_ptr<Stage> {
-            MotorCalibrationStageOptions o;
-            auto& f = o.fit;
-            f.left_motor_polarity = Polarity(s, "left_motor_polarity", "1 if a positive duty turns the left wheel forward, else -1");
-            f.left_encoder_polarity = Polarity(s, "left_encoder_polarity", "1 if the left encoder counts up going forward, else -1");
-            f.right_motor_polarity = Polarity(s, "right_motor_polarity", "1 if a positive duty turns the right wheel forward, else -1");
-            f.right_encoder_polarity = Polarity(s, "right_encoder_polarity", "1 if the right encoder counts up going forward, else -1");
-            f.min_speed_rad_s = s.GetDouble("min_speed_rad_s", f.min_speed_rad_s, "slower samples are stalls, not fitted [rad/s]", 0.0);
-            f.min_duty = s.GetDouble("min_duty", f.min_duty, "samples with a smaller |duty| are not fitted", 0.0, 1.0);
-            f.loss_scale = s.GetDouble("loss_scale", f.loss_scale, "Cauchy loss scale [duty]: residuals well beyond it (slips, stalls) barely count", 1e-6, 1.0);
-            f.max_abs_slope = s.GetDouble("max_abs_slope", f.max_abs_slope, "acceptance: |slope| at most this (the reports' 0.10)", 0.0);
-            f.max_abs_punch = s.GetDouble("max_abs_punch", f.max_abs_punch, "acceptance: |punch| at most this (the reports' 0.10)", 0.0);
-            f.min_samples = static_cast<int>(s.GetInt("min_samples", f.min_samples, "samples needed per wheel and direction", 2));
-            o.speed_from = s.GetChoice("speed_from", o.speed_from, {"auto", "wheel_speed", "encoders"},
-                                       "logs: measured wheel speeds (MBOT_MOTOR_VEL), speeds from encoder ticks, or auto (the former when present)");
-            o.settle_s = s.GetDouble("settle_s", o.settle_s, "logs: a duty must hold this long before its samples count [s]", 0.0, 60.0);
-            o.duty_tolerance = s.GetDouble("duty_tolerance", o.duty_tolerance, "logs: duty changes up to this still count as holding", 0.0, 1.0);
-            o.left_channel = static_cast<int>(s.GetInt("left_channel", o.left_channel, "motor channel number of the left wheel (CSV in and out)", 0, 16));
-            o.right_channel = static_cast<int>(s.GetInt("right_channel", o.right_channel, "motor channel number of the right wheel (CSV in and out)", 0, 16));
-            if (!s.describing() && o.left_channel == o.right_channel) s.Fail("right_channel", "must differ from left_channel");
-            o.snippet_section = s.GetString("snippet_section", o.snippet_section, "section name written in motor_calibration.ini");
-            o.geometry.gear_ratio = s.GetDouble("gear_ratio", o.geometry.gear_ratio, "logs without wheel speeds: motor turns per wheel turn", 1e-3, 1e4);
-            o.geometry.encoder_resolution = s.GetDouble("encoder_resolution", o.geometry.encoder_resolution,
-                                                        "logs without wheel speeds: encoder counts per motor turn", 1.0, 1e6);
-            return std::make_unique<MotorCalibrationStage>(o);
-          }};
+  return {
+      "motor_calibration",
+      "fits the motor model (slope, punch per wheel and direction) from calibration samples or a log's PWM and "
+      "wheel speeds; writes an INI snippet, the CHANNEL,DIRECTION,M,B CSV, a plot and a report",
+      [](config::Section& s) -> std::unique_ptr<Stage> {
+        MotorCalibrationStageOptions o;
+        auto& f = o.fit;
+        f.left_motor_polarity =
+            Polarity(s, "left_motor_polarity", "1 if a positive duty turns the left wheel forward, else -1");
+        f.left_encoder_polarity =
+            Polarity(s, "left_encoder_polarity", "1 if the left encoder counts up going forward, else -1");
+        f.right_motor_polarity =
+            Polarity(s, "right_motor_polarity", "1 if a positive duty turns the right wheel forward, else -1");
+        f.right_encoder_polarity =
+            Polarity(s, "right_encoder_polarity", "1 if the right encoder counts up going forward, else -1");
+        f.min_speed_rad_s =
+            s.GetDouble("min_speed_rad_s", f.min_speed_rad_s, "slower samples are stalls, not fitted [rad/s]", 0.0);
+        f.min_duty = s.GetDouble("min_duty", f.min_duty, "samples with a smaller |duty| are not fitted", 0.0, 1.0);
+        f.loss_scale =
+            s.GetDouble("loss_scale", f.loss_scale,
+                        "Cauchy loss scale [duty]: residuals well beyond it (slips, stalls) barely count", 1e-6, 1.0);
+        f.max_abs_slope =
+            s.GetDouble("max_abs_slope", f.max_abs_slope, "acceptance: |slope| at most this (the reports' 0.10)", 0.0);
+        f.max_abs_punch =
+            s.GetDouble("max_abs_punch", f.max_abs_punch, "acceptance: |punch| at most this (the reports' 0.10)", 0.0);
+        f.min_samples =
+            static_cast<int>(s.GetInt("min_samples", f.min_samples, "samples needed per wheel and direction", 2));
+        o.speed_from = s.GetChoice("speed_from", o.speed_from, {"auto", "wheel_speed", "encoders"},
+                                   "logs: measured wheel speeds (MBOT_MOTOR_VEL), speeds from encoder ticks, or auto "
+                                   "(the former when present)");
+        o.settle_s = s.GetDouble("settle_s", o.settle_s,
+                                 "logs: a duty must hold this long before its samples count [s]", 0.0, 60.0);
+        o.duty_tolerance = s.GetDouble("duty_tolerance", o.duty_tolerance,
+                                       "logs: duty changes up to this still count as holding", 0.0, 1.0);
+        o.left_channel = static_cast<int>(
+            s.GetInt("left_channel", o.left_channel, "motor channel number of the left wheel (CSV in and out)", 0, 16));
+        o.right_channel = static_cast<int>(s.GetInt("right_channel", o.right_channel,
+                                                    "motor channel number of the right wheel (CSV in and out)", 0, 16));
+        if (!s.describing() && o.left_channel == o.right_channel)
+          s.Fail("right_channel", "must differ from left_channel");
+        o.snippet_section =
+            s.GetString("snippet_section", o.snippet_section, "section name written in motor_calibration.ini");
+        o.geometry.gear_ratio = s.GetDouble("gear_ratio", o.geometry.gear_ratio,
+                                            "logs without wheel speeds: motor turns per wheel turn", 1e-3, 1e4);
+        o.geometry.encoder_resolution =
+            s.GetDouble("encoder_resolution", o.geometry.encoder_resolution,
+                        "logs without wheel speeds: encoder counts per motor turn", 1.0, 1e6);
+        return std::make_unique<MotorCalibrationStage>(o);
+      }};
 }
 
 }  // namespace mbot::app

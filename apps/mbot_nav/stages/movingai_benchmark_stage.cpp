@@ -23,9 +23,9 @@ using Clock = std::chrono::steady_clock;
 struct MovingAiBenchmarkOptions {
   std::string csv_file = "results.csv";
   std::string json_file = "summary.json";
-  double tolerance = 0.01;        // |length - optimal| allowed
-  bool require_optimal = true;    // fail the run when a scenario is not solved optimally
-  int sample_every = 1;           // run scenarios whose index is a multiple of this (1: all)
+  double tolerance = 0.01;      // |length - optimal| allowed
+  bool require_optimal = true;  // fail the run when a scenario is not solved optimally
+  int sample_every = 1;         // run scenarios whose index is a multiple of this (1: all)
 };
 
 struct Row {
@@ -53,7 +53,8 @@ class MovingAiBenchmarkStage : public Stage {
     if (ev.kind == drivers::EventKind::kMap) {
       map_name_ = ev.channel;
       const auto& grid = std::get<std::shared_ptr<const mapping::OccupancyGrid>>(ev.payload);
-      if (grid->resolution() != 1.0) throw std::runtime_error("movingai_benchmark: map '" + ev.channel + "' is not a Moving AI map");
+      if (grid->resolution() != 1.0)
+        throw std::runtime_error("movingai_benchmark: map '" + ev.channel + "' is not a Moving AI map");
       planner_.SetMap(planning::ObstacleDistanceGrid(*grid, {}));
       return;
     }
@@ -85,8 +86,10 @@ class MovingAiBenchmarkStage : public Stage {
       total_us += r.time_us;
       expansions += r.expansions;
       found += r.found;
-      if (r.found && std::abs(r.length - r.optimal) <= options_.tolerance) ++optimal;
-      else wrong.push_back(&r);
+      if (r.found && std::abs(r.length - r.optimal) <= options_.tolerance)
+        ++optimal;
+      else
+        wrong.push_back(&r);
     }
     const std::string csv = ctx.output_dir + "/" + options_.csv_file;
     WriteFileAtomically(csv, [&](std::ostream& out) {
@@ -104,7 +107,8 @@ class MovingAiBenchmarkStage : public Stage {
     std::snprintf(buf, sizeof buf,
                   "%s: %zu problems, %d found, %d optimal within %.2g; time per query mean %.1f us, median %.1f us, "
                   "max %.1f us; %.2f M expansions/s\n",
-                  map_name_.c_str(), rows_.size(), found, optimal, options_.tolerance, t.mean, t.median, t.max, rate * 1e-6);
+                  map_name_.c_str(), rows_.size(), found, optimal, options_.tolerance, t.mean, t.median, t.max,
+                  rate * 1e-6);
     std::cout << buf;
     for (size_t i = 0; i < wrong.size() && i < 10; ++i) {
       std::printf("  scenario %d: found %d, length %.4f, optimal %.4f\n", wrong[i]->index, wrong[i]->found,
@@ -114,7 +118,8 @@ class MovingAiBenchmarkStage : public Stage {
       out << "{\"map\": " << JsonString(map_name_) << ", \"problems\": " << rows_.size() << ", \"found\": " << found
           << ", \"optimal\": " << optimal << ", \"tolerance\": " << Num(options_.tolerance)
           << ", \"time_us\": " << t.Json() << ", \"expansions\": " << expansions
-          << ", \"expansions_per_s\": " << Num(rate) << ", \"interrupted\": " << (interrupted ? "true" : "false") << "}\n";
+          << ", \"expansions_per_s\": " << Num(rate) << ", \"interrupted\": " << (interrupted ? "true" : "false")
+          << "}\n";
     });
     mbot::log::Info("wrote " + csv);
     if (options_.require_optimal && !wrong.empty() && !interrupted) {
@@ -134,7 +139,8 @@ class MovingAiBenchmarkStage : public Stage {
 
 StageType MovingAiBenchmarkStageType() {
   return {"movingai_benchmark",
-          "runs the scenarios of a Moving AI .map.scen file (all, or every sample_every-th) (octile, no corner cutting) and checks optimal lengths",
+          "runs the scenarios of a Moving AI .map.scen file (all, or every sample_every-th) (octile, no corner "
+          "cutting) and checks optimal lengths",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             MovingAiBenchmarkOptions o;
             o.csv_file = s.GetString("csv_file", o.csv_file, "per-scenario results in output.dir");
@@ -142,10 +148,11 @@ StageType MovingAiBenchmarkStageType() {
             o.tolerance = s.GetDouble("tolerance", o.tolerance, "allowed |length - optimal|", 0.0, 1e6);
             o.require_optimal = s.GetBool("require_optimal", o.require_optimal,
                                           "fail the run when any scenario is not solved optimally");
-            o.sample_every = static_cast<int>(s.GetInt("sample_every", o.sample_every,
-                                                       "run only scenarios whose index is a multiple of this (1: every one; "
-                                                       "the default ctest run samples, the movingai_full label runs all)",
-                                                       1, 1000000));
+            o.sample_every =
+                static_cast<int>(s.GetInt("sample_every", o.sample_every,
+                                          "run only scenarios whose index is a multiple of this (1: every one; "
+                                          "the default ctest run samples, the movingai_full label runs all)",
+                                          1, 1000000));
             return std::make_unique<MovingAiBenchmarkStage>(o);
           }};
 }

@@ -73,12 +73,13 @@ class OdometryStage : public Stage {
       mbot::log::Warn("odometry: the source has no encoder messages; nothing to write");
       return;
     }
-    if (imu_count_ == 0) mbot::log::Warn("odometry: the source has no IMU messages; every heading mode equals encoders");
+    if (imu_count_ == 0)
+      mbot::log::Warn("odometry: the source has no IMU messages; every heading mode equals encoders");
     const int64_t gap = static_cast<int64_t>(options_.max_pose_gap_s * 1e6);
     std::ostringstream j;
-    j << "{\n  \"source\": " << JsonString(ctx.source_path) << ",\n  \"interrupted\": " << (interrupted ? "true" : "false")
-      << ",\n  \"imu_messages\": " << imu_count_ << ",\n  \"ground_truth\": " << (truth_.empty() ? "false" : "true")
-      << ",\n  \"variants\": {";
+    j << "{\n  \"source\": " << JsonString(ctx.source_path)
+      << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"imu_messages\": " << imu_count_
+      << ",\n  \"ground_truth\": " << (truth_.empty() ? "false" : "true") << ",\n  \"variants\": {";
     std::vector<drivers::MapOverlay> overlays;
     const uint8_t colours[][3] = {{220, 40, 40}, {40, 90, 230}, {0, 160, 120}, {200, 120, 0}};
     std::vector<Pose2D> truth_paired_first;
@@ -115,7 +116,8 @@ class OdometryStage : public Stage {
       overlays.push_back(std::move(path));
     }
     j << "\n  }\n}\n";
-    if (!truth_paired_first.empty()) overlays.push_back({truth_paired_first, 0, 0, 0, false, "ground truth (anchored frame)"});
+    if (!truth_paired_first.empty())
+      overlays.push_back({truth_paired_first, 0, 0, 0, false, "ground truth (anchored frame)"});
     WriteFileAtomically(ctx.output_dir + "/odometry.json", [&](std::ostream& o) { o << j.str(); });
     WritePicture(overlays, ctx.output_dir + "/odometry_comparison.png");
     mbot::log::Info("odometry: wrote odometry_*.tum, odometry.json and odometry_comparison.png in " + ctx.output_dir);
@@ -131,11 +133,13 @@ class OdometryStage : public Stage {
   void WritePicture(const std::vector<drivers::MapOverlay>& overlays, const std::string& path) const {
     double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
     for (const auto& o : overlays) {
-      for (const Pose2D& p : o.poses) x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
+      for (const Pose2D& p : o.poses)
+        x0 = std::min(x0, p.x), y0 = std::min(y0, p.y), x1 = std::max(x1, p.x), y1 = std::max(y1, p.y);
     }
     if (x0 > x1) return;
     const double res = 1.0 / options_.png_pixels_per_m, margin = 0.3;
-    const int w = static_cast<int>(std::ceil((x1 - x0 + 2 * margin) / res)), h = static_cast<int>(std::ceil((y1 - y0 + 2 * margin) / res));
+    const int w = static_cast<int>(std::ceil((x1 - x0 + 2 * margin) / res)),
+              h = static_cast<int>(std::ceil((y1 - y0 + 2 * margin) / res));
     const mapping::OccupancyGrid blank(std::min(w, 4000), std::min(h, 4000), res, x0 - margin, y0 - margin, -60);
     drivers::WriteMapPngWithOverlays(blank, overlays, 1, path);
   }
@@ -149,23 +153,35 @@ class OdometryStage : public Stage {
 }  // namespace
 
 StageType OdometryStageType() {
-  return {"odometry", "recomputes dead reckoning from encoders and IMU (encoders, gyrodometry, complementary, IMU yaw) and scores it against ground truth",
+  return {"odometry",
+          "recomputes dead reckoning from encoders and IMU (encoders, gyrodometry, complementary, IMU yaw) and scores "
+          "it against ground truth",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             OdometryStageOptions o;
             o.wheels = motion::ParseWheelConstants(s);
-            o.headings = s.GetList("headings", o.headings, "heading modes to run: encoders, gyrodometry, complementary, imu_yaw");
+            o.headings = s.GetList("headings", o.headings,
+                                   "heading modes to run: encoders, gyrodometry, complementary, imu_yaw");
             for (const auto& h : o.headings) {
-              if (!kHeadings.count(h)) s.Fail("headings", "unknown heading mode '" + h + "' (encoders, gyrodometry, complementary, imu_yaw)");
+              if (!kHeadings.count(h))
+                s.Fail("headings", "unknown heading mode '" + h + "' (encoders, gyrodometry, complementary, imu_yaw)");
             }
-            o.fusion.threshold_rad_s = s.GetDouble("threshold_rad_s", o.fusion.threshold_rad_s,
-                                                   "gyrodometry: use the gyro when gyro and encoder turn rates differ by more than this", 0.0);
-            o.fusion.gyro_weight = s.GetDouble("gyro_weight", o.fusion.gyro_weight, "complementary: share of the gyro's heading change", 0.0, 1.0);
-            o.fusion.gyro_scale = s.GetDouble("gyro_scale", o.fusion.gyro_scale, "multiplies the gyro's yaw rate (0.0174533 for a gyro reporting deg/s)");
-            o.use_stamps = s.GetChoice("clock", "stamp", {"stamp", "event"},
-                                       "integrate on the messages' own stamps (the robot's clock) or on the log's event times") == "stamp";
-            o.fusion.estimate_bias = s.GetBool("estimate_bias", o.fusion.estimate_bias, "estimate the gyro bias while the wheels stand still at the start");
-            o.max_pose_gap_s = s.GetDouble("max_pose_gap_s", o.max_pose_gap_s, "ground truth is interpolated across gaps up to this", 0.0);
-            o.png_pixels_per_m = static_cast<int>(s.GetInt("png_pixels_per_m", o.png_pixels_per_m, "resolution of odometry_comparison.png", 1, 1000));
+            o.fusion.threshold_rad_s =
+                s.GetDouble("threshold_rad_s", o.fusion.threshold_rad_s,
+                            "gyrodometry: use the gyro when gyro and encoder turn rates differ by more than this", 0.0);
+            o.fusion.gyro_weight = s.GetDouble("gyro_weight", o.fusion.gyro_weight,
+                                               "complementary: share of the gyro's heading change", 0.0, 1.0);
+            o.fusion.gyro_scale = s.GetDouble("gyro_scale", o.fusion.gyro_scale,
+                                              "multiplies the gyro's yaw rate (0.0174533 for a gyro reporting deg/s)");
+            o.use_stamps =
+                s.GetChoice("clock", "stamp", {"stamp", "event"},
+                            "integrate on the messages' own stamps (the robot's clock) or on the log's event times") ==
+                "stamp";
+            o.fusion.estimate_bias = s.GetBool("estimate_bias", o.fusion.estimate_bias,
+                                               "estimate the gyro bias while the wheels stand still at the start");
+            o.max_pose_gap_s = s.GetDouble("max_pose_gap_s", o.max_pose_gap_s,
+                                           "ground truth is interpolated across gaps up to this", 0.0);
+            o.png_pixels_per_m = static_cast<int>(
+                s.GetInt("png_pixels_per_m", o.png_pixels_per_m, "resolution of odometry_comparison.png", 1, 1000));
             return std::make_unique<OdometryStage>(o);
           }};
 }

@@ -35,7 +35,8 @@ class RecorderStage : public Stage {
     if (!recorder_) return;
     recorder_->Close();
     std::string skipped;
-    for (const auto& [channel, n] : recorder_->skipped()) skipped += (skipped.empty() ? "" : ", ") + channel + " " + std::to_string(n);
+    for (const auto& [channel, n] : recorder_->skipped())
+      skipped += (skipped.empty() ? "" : ", ") + channel + " " + std::to_string(n);
     mbot::log::Info("recorder: " + std::to_string(recorder_->recorded()) + " messages to " + path_ +
                     (interrupted ? " (interrupted: everything up to the stop)" : "") +
                     (skipped.empty() ? "" : "; not recordable as LCM messages: " + skipped));
@@ -56,7 +57,8 @@ StageType RecorderStageType() {
           [](config::Section& s) -> std::unique_ptr<Stage> {
             RecorderOptions o;
             o.file = s.GetString("file", o.file, "the log file, in the output folder");
-            for (const std::string& c : s.GetList("channels", {}, "record only these channels (empty: every recordable one)")) {
+            for (const std::string& c :
+                 s.GetList("channels", {}, "record only these channels (empty: every recordable one)")) {
               o.channels.insert(c);
             }
             return std::make_unique<RecorderStage>(o);

@@ -32,21 +32,25 @@ std::string ErrorJson(const sim::PoseError& e) {
 }
 
 // score.json: the score as the rubric counts it.
-std::string ScoreJson(const sim::Score& s, const RunContext& ctx, const std::string& arena, bool interrupted, double wall_s) {
+std::string ScoreJson(const sim::Score& s, const RunContext& ctx, const std::string& arena, bool interrupted,
+                      double wall_s) {
   const double rtf = wall_s > 0 ? s.sim_s / wall_s : 0.0;
   std::ostringstream j;
   j << "{\n  \"event\": " << JsonString(sim::ToString(s.event)) << ",\n  \"world\": " << JsonString(ctx.source_path)
-    << ",\n  \"arena\": " << JsonString(arena) << ",\n  \"seed\": " << ctx.seed << ",\n  \"state\": " << JsonString(mission::ToString(s.state))
-    << ",\n  \"detail\": " << JsonString(s.detail) << ",\n  \"completed\": " << (s.completed ? "true" : "false")
-    << ",\n  \"timed_out\": " << (s.timed_out ? "true" : "false") << ",\n  \"interrupted\": " << (interrupted ? "true" : "false")
-    << ",\n  \"time_s\": " << Num(s.time_s) << ",\n  \"sim_seconds\": " << Num(s.sim_s) << ",\n  \"wall_seconds\": " << Num(wall_s)
-    << ",\n  \"real_time_factor\": " << Num(rtf) << ",\n  \"collisions\": " << s.collisions << ",\n  \"start\": " << PoseJson(s.start)
-    << ",\n  \"final\": " << PoseJson(s.final_pose);
+    << ",\n  \"arena\": " << JsonString(arena) << ",\n  \"seed\": " << ctx.seed
+    << ",\n  \"state\": " << JsonString(mission::ToString(s.state)) << ",\n  \"detail\": " << JsonString(s.detail)
+    << ",\n  \"completed\": " << (s.completed ? "true" : "false")
+    << ",\n  \"timed_out\": " << (s.timed_out ? "true" : "false")
+    << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"time_s\": " << Num(s.time_s)
+    << ",\n  \"sim_seconds\": " << Num(s.sim_s) << ",\n  \"wall_seconds\": " << Num(wall_s)
+    << ",\n  \"real_time_factor\": " << Num(rtf) << ",\n  \"collisions\": " << s.collisions
+    << ",\n  \"start\": " << PoseJson(s.start) << ",\n  \"final\": " << PoseJson(s.final_pose);
   if (s.final_error) j << ",\n  \"final_error\": " << ErrorJson(*s.final_error);
   if (s.slam_final_error) j << ",\n  \"slam_final_error\": " << ErrorJson(*s.slam_final_error);
   if (s.map) {
     j << ",\n  \"map\": {\"coverage\": " << Num(s.map->coverage) << ", \"wall_precision\": " << Num(s.map->precision)
-      << ", \"reachable_cells\": " << s.map->reachable_cells << ", \"occupied_cells\": " << s.map->occupied_cells << "}";
+      << ", \"reachable_cells\": " << s.map->reachable_cells << ", \"occupied_cells\": " << s.map->occupied_cells
+      << "}";
   }
   if (s.event == sim::CompetitionEvent::kWarehouse) {
     j << ",\n  \"localized_at_s\": " << (s.localized_at_s ? Num(*s.localized_at_s) : "null")
@@ -54,7 +58,8 @@ std::string ScoreJson(const sim::Score& s, const RunContext& ctx, const std::str
     for (size_t k = 0; k < s.stops.size(); ++k) {
       const sim::StopResult& r = s.stops[k];
       j << (k ? "," : "") << "\n    {\"stop\": " << JsonString(r.stop.Name()) << ", \"pose\": " << PoseJson(r.stop.pose)
-        << ", \"done_at_s\": " << (r.done_at_s ? Num(*r.done_at_s) : "null") << ", \"missed\": " << (r.missed ? "true" : "false") << "}";
+        << ", \"done_at_s\": " << (r.done_at_s ? Num(*r.done_at_s) : "null")
+        << ", \"missed\": " << (r.missed ? "true" : "false") << "}";
     }
     j << "\n  ]";
   }
@@ -73,7 +78,8 @@ class RefereeStage : public Stage {
     try {
       referee_ = std::make_unique<sim::Referee>(o_.referee, sim::World::Load(ctx.source_path), ctx.seed);
     } catch (const std::invalid_argument& e) {
-      throw std::runtime_error("referee: the world " + ctx.source_path + " has no Warehouse ('pose target' and 'pose dropoff' lines): " + e.what());
+      throw std::runtime_error("referee: the world " + ctx.source_path +
+                               " has no Warehouse ('pose target' and 'pose dropoff' lines): " + e.what());
     }
     wall0_ = std::chrono::steady_clock::now();
   }
@@ -86,9 +92,12 @@ class RefereeStage : public Stage {
       case EventKind::kPoseEstimate: referee_->OnSlamPose(ev.t_us, std::get<Pose2D>(ev.payload)); break;
       case EventKind::kMap: referee_->OnMap(std::get<std::shared_ptr<const mapping::OccupancyGrid>>(ev.payload)); break;
       case EventKind::kPath: path_ = std::get<drivers::Path>(ev.payload).poses; break;
-      case EventKind::kSlamStatus: referee_->OnSlamState(ev.t_us, std::get<mapping::SlamStatus>(ev.payload).state); break;
+      case EventKind::kSlamStatus:
+        referee_->OnSlamState(ev.t_us, std::get<mapping::SlamStatus>(ev.payload).state);
+        break;
       case EventKind::kMissionStatus:
-        if (ev.channel == o_.mission_status_channel) referee_->OnMissionStatus(ev.t_us, std::get<mission::MissionStatus>(ev.payload));
+        if (ev.channel == o_.mission_status_channel)
+          referee_->OnMissionStatus(ev.t_us, std::get<mission::MissionStatus>(ev.payload));
         break;
       default: break;
     }
@@ -107,13 +116,15 @@ class RefereeStage : public Stage {
     const std::string result = s.timed_out ? "time limit" : mission::ToString(s.state);
     const double rtf = wall_s > 0 ? s.sim_s / wall_s : 0.0;
     std::ostringstream t;
-    t << "\n" << sim::Title(s.event) << " - arena " << arena << ", seed " << ctx.seed << ": " << result << " after " << Num(s.time_s, 4)
-      << " s (" << Num(rtf, 3) << "x real time), " << s.collisions << " collisions\n";
+    t << "\n"
+      << sim::Title(s.event) << " - arena " << arena << ", seed " << ctx.seed << ": " << result << " after "
+      << Num(s.time_s, 4) << " s (" << Num(rtf, 3) << "x real time), " << s.collisions << " collisions\n";
     for (const sim::RubricItem& i : s.items) {
-      t << "  " << std::left << std::setw(14) << i.name << std::setw(74) << i.detail << std::right << std::setw(4) << i.points
-        << " / " << i.max << "\n";
+      t << "  " << std::left << std::setw(14) << i.name << std::setw(74) << i.detail << std::right << std::setw(4)
+        << i.points << " / " << i.max << "\n";
     }
-    t << "  " << std::left << std::setw(88) << "total" << std::right << std::setw(4) << s.total << " / " << s.max_total << "\n";
+    t << "  " << std::left << std::setw(88) << "total" << std::right << std::setw(4) << s.total << " / " << s.max_total
+      << "\n";
     std::cout << t.str() << std::flush;
 
     const std::string dir = ctx.output_dir;
@@ -126,17 +137,24 @@ class RefereeStage : public Stage {
       const Pose2D inv = s.map_frame.Inverse();
       for (size_t i = 0; i < referee_->truth().size(); i += 5) truth.push_back(inv.Compose(referee_->truth()[i].pose));
       for (const auto& st : referee_->stops()) stops.push_back(inv.Compose(st.pose));
-      std::vector<drivers::MapOverlay> overlays{{truth, 0, 0, 0, false, "true path"}, {driven, 31, 119, 180, false, "SLAM path"}};
+      std::vector<drivers::MapOverlay> overlays{{truth, 0, 0, 0, false, "true path"},
+                                                {driven, 31, 119, 180, false, "SLAM path"}};
       if (!path_.empty()) overlays.push_back({path_, 214, 39, 40, false, "last planned path"});
       if (!stops.empty()) overlays.push_back({stops, 44, 160, 44, true, "targets and drop-offs"});
       drivers::WriteMapPngWithOverlays(mapping::CropToKnown(*map, 0.3), overlays, 4, dir + "/final_map.png");
     }
-    WriteFileAtomically(dir + "/score.json", [&](std::ostream& out) { out << ScoreJson(s, ctx, arena, interrupted, wall_s); });
+    WriteFileAtomically(dir + "/score.json",
+                        [&](std::ostream& out) { out << ScoreJson(s, ctx, arena, interrupted, wall_s); });
     if (ctx.results) {
-      ctx.results->insert(ctx.results->end(),
-                          {{"event", sim::Title(s.event)}, {"arena", arena}, {"seed", std::to_string(ctx.seed)}, {"result", result},
-                           {"time_s", Num(s.time_s, 4)}, {"points", std::to_string(s.total)}, {"max_points", std::to_string(s.max_total)},
-                           {"collisions", std::to_string(s.collisions)}, {"real_time_factor", Num(rtf, 3)}});
+      ctx.results->insert(ctx.results->end(), {{"event", sim::Title(s.event)},
+                                               {"arena", arena},
+                                               {"seed", std::to_string(ctx.seed)},
+                                               {"result", result},
+                                               {"time_s", Num(s.time_s, 4)},
+                                               {"points", std::to_string(s.total)},
+                                               {"max_points", std::to_string(s.max_total)},
+                                               {"collisions", std::to_string(s.collisions)},
+                                               {"real_time_factor", Num(rtf, 3)}});
     }
   }
 
@@ -151,22 +169,26 @@ class RefereeStage : public Stage {
 }  // namespace
 
 StageType RefereeStageType() {
-  return {"referee",
-          "scores a competition event on the simulator (libs/sim: pose tiers, map quality, time, collisions), ends the run "
-          "when the mission finishes or time runs out, writes score.json, trajectories and the final map",
-          [](config::Section& s) -> std::unique_ptr<Stage> {
-            RefereeStageOptions o;
-            auto& r = o.referee;
-            r.event = s.GetEnum("event", r.event,
-                                {{"speed_run", sim::CompetitionEvent::kSpeedRun},
-                                 {"maze_explorer", sim::CompetitionEvent::kMazeExplorer},
-                                 {"warehouse", sim::CompetitionEvent::kWarehouse}},
-                                "which event is scored");
-            r.time_limit_s = s.GetDouble("time_limit_s", r.time_limit_s, "the run ends here if the mission has not [s]", 1.0, 1e5);
-            r.finish_delay_s = s.GetDouble("finish_delay_s", r.finish_delay_s, "simulate this long after the mission ends [s]", 0.0, 60.0);
-            o.mission_status_channel = s.GetString("mission_status_channel", o.mission_status_channel, "channel of the mission's states");
-            return std::make_unique<RefereeStage>(o);
-          }};
+  return {
+      "referee",
+      "scores a competition event on the simulator (libs/sim: pose tiers, map quality, time, collisions), ends the run "
+      "when the mission finishes or time runs out, writes score.json, trajectories and the final map",
+      [](config::Section& s) -> std::unique_ptr<Stage> {
+        RefereeStageOptions o;
+        auto& r = o.referee;
+        r.event = s.GetEnum("event", r.event,
+                            {{"speed_run", sim::CompetitionEvent::kSpeedRun},
+                             {"maze_explorer", sim::CompetitionEvent::kMazeExplorer},
+                             {"warehouse", sim::CompetitionEvent::kWarehouse}},
+                            "which event is scored");
+        r.time_limit_s =
+            s.GetDouble("time_limit_s", r.time_limit_s, "the run ends here if the mission has not [s]", 1.0, 1e5);
+        r.finish_delay_s =
+            s.GetDouble("finish_delay_s", r.finish_delay_s, "simulate this long after the mission ends [s]", 0.0, 60.0);
+        o.mission_status_channel =
+            s.GetString("mission_status_channel", o.mission_status_channel, "channel of the mission's states");
+        return std::make_unique<RefereeStage>(o);
+      }};
 }
 
 }  // namespace mbot::app

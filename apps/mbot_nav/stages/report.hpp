@@ -37,7 +37,8 @@ inline std::string JsonString(const std::string& s) {
 // One TUM trajectory line, "t x y z qx qy qz qw", for a planar pose at t seconds.
 inline std::string TumLine(double t_s, double x, double y, double theta) {
   char line[160];
-  std::snprintf(line, sizeof line, "%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", t_s, x, y, std::sin(theta / 2), std::cos(theta / 2));
+  std::snprintf(line, sizeof line, "%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", t_s, x, y, std::sin(theta / 2),
+                std::cos(theta / 2));
   return line;
 }
 
@@ -82,15 +83,17 @@ inline std::string PoseJson(const motion::Pose2D& p) {
 }
 
 inline std::string StatsJson(const motion::ErrorStats& s, double scale = 1.0) {
-  return "{\"rmse\": " + Num(s.rmse * scale) + ", \"mean\": " + Num(s.mean * scale) + ", \"max\": " + Num(s.max * scale) +
-         ", \"std\": " + Num(s.std * scale) + "}";
+  return "{\"rmse\": " + Num(s.rmse * scale) + ", \"mean\": " + Num(s.mean * scale) +
+         ", \"max\": " + Num(s.max * scale) + ", \"std\": " + Num(s.std * scale) + "}";
 }
 
 inline std::string AteJson(const motion::AteResult& a) {
-  return "{\"samples\": " + std::to_string(a.samples) + ", \"x_m\": " + StatsJson(a.x) + ", \"y_m\": " + StatsJson(a.y) +
-         ", \"xy_m\": " + StatsJson(a.xy) + ", \"theta_deg\": " + StatsJson(a.theta, 180.0 / M_PI) +
+  return "{\"samples\": " + std::to_string(a.samples) + ", \"x_m\": " + StatsJson(a.x) +
+         ", \"y_m\": " + StatsJson(a.y) + ", \"xy_m\": " + StatsJson(a.xy) +
+         ", \"theta_deg\": " + StatsJson(a.theta, 180.0 / M_PI) +
          ", \"final_error\": {\"x_m\": " + Num(a.final_error.x) + ", \"y_m\": " + Num(a.final_error.y) +
-         ", \"theta_deg\": " + Num(a.final_error.theta * 180.0 / M_PI) + "}, \"alignment\": " + PoseJson(a.alignment) + "}";
+         ", \"theta_deg\": " + Num(a.final_error.theta * 180.0 / M_PI) + "}, \"alignment\": " + PoseJson(a.alignment) +
+         "}";
 }
 
 // {"aligned": …, "anchored": …, "unaligned": …}: an estimate's errors under each convention.

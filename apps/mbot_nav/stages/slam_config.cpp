@@ -27,12 +27,12 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
   o.wheels = motion::ParseWheelConstants(s);  // used when odometry = encoders
   o.ground_truth_channel = s.GetString("ground_truth_channel", "", "ground-truth channel ('' = the first one seen)");
   o.reference_channel = s.GetString("reference_channel", "", "reference-pose channel ('' = the first one seen)");
-  o.mapping_poses_from_reference =
-      s.GetChoice("mapping_poses", "ground_truth", {"ground_truth", "reference"},
-                  "mapping-only: where the poses come from") == "reference";
+  o.mapping_poses_from_reference = s.GetChoice("mapping_poses", "ground_truth", {"ground_truth", "reference"},
+                                               "mapping-only: where the poses come from") == "reference";
   o.truth_is_reference = s.GetChoice("truth", "ground_truth", {"ground_truth", "reference"},
                                      "what metrics.json scores against") == "reference";
-  const std::vector<std::string> lp = s.GetList("lidar_pose", {"auto"}, "sensor pose on the robot: auto (as the source says) or x, y, theta_deg");
+  const std::vector<std::string> lp =
+      s.GetList("lidar_pose", {"auto"}, "sensor pose on the robot: auto (as the source says) or x, y, theta_deg");
   if (lp.size() == 1 && lp[0] == "auto") {
     o.lidar_pose_from_scan = true;
   } else {
@@ -49,15 +49,16 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
                              {"spread", mapping::BeamTiming::kSpread},
                              {"none", mapping::BeamTiming::kNone}},
                             "per-beam time: the beams' own times, spread evenly over the time since the last scan, "
-                              "or none (all at the scan time); auto picks the first that applies");
+                            "or none (all at the scan time); auto picks the first that applies");
   o.lidar_time_offset_us = static_cast<int64_t>(
-      std::llround(s.GetDouble("lidar_time_offset_s", 0.0, "added to a scan's time (its last beam) before poses are looked up", -1.0, 1.0) * 1e6));
+      std::llround(s.GetDouble("lidar_time_offset_s", 0.0,
+                               "added to a scan's time (its last beam) before poses are looked up", -1.0, 1.0) *
+                   1e6));
   o.max_pose_gap_s = s.GetDouble("max_pose_gap_s", 0.5, "largest gap in a pose series to interpolate across", 0.0);
 
-
   // Start.
-  const std::vector<std::string> init = s.GetList("initial_pose", {"origin"},
-      "origin | odometry | ground_truth | reference | global | x, y, theta_deg");
+  const std::vector<std::string> init =
+      s.GetList("initial_pose", {"origin"}, "origin | odometry | ground_truth | reference | global | x, y, theta_deg");
   if (init.size() == 1 && (init[0] == "origin" || init[0] == "odometry" || init[0] == "ground_truth" ||
                            init[0] == "reference" || init[0] == "global")) {
     o.initial = init[0];
@@ -74,25 +75,36 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
 
   // Perturbations.
   auto& pert = o.perturbation;
-  pert.noise_trans = s.GetDouble("odometry_noise_trans", 0.0, "injected odometry noise: sigma per metre of each step", 0.0);
-  pert.noise_rot = s.GetDouble("odometry_noise_rot", 0.0, "injected heading noise: sigma per radian and metre of each step", 0.0);
-  pert.kidnap_at_s = s.GetDouble("kidnap_at_s", -1.0, "from this time on, odometry is offset by kidnap_offset (< 0: never)");
+  pert.noise_trans =
+      s.GetDouble("odometry_noise_trans", 0.0, "injected odometry noise: sigma per metre of each step", 0.0);
+  pert.noise_rot =
+      s.GetDouble("odometry_noise_rot", 0.0, "injected heading noise: sigma per radian and metre of each step", 0.0);
+  pert.kidnap_at_s =
+      s.GetDouble("kidnap_at_s", -1.0, "from this time on, odometry is offset by kidnap_offset (< 0: never)");
   const config::PoseValue k = s.GetPose("kidnap_offset", {1.0, 0.0, M_PI / 2}, "the kidnapping jump");
   pert.kidnap_offset = {k.x_m, k.y_m, k.theta_rad};
 
   // Outputs.
-  o.score_from_us = static_cast<int64_t>(s.GetDouble("score_from_s", 0.0, "ATE counts scans from this long after the start", 0.0) * 1e6);
+  o.score_from_us = static_cast<int64_t>(
+      s.GetDouble("score_from_s", 0.0, "ATE counts scans from this long after the start", 0.0) * 1e6);
   o.score_max_latency_us = static_cast<int64_t>(
-      s.GetDouble("score_max_latency_s", 0.0, "ATE skips scans that reached the logger later than this after their stamp "
-                  "(the logged motion capture is stamped on arrival and is late too); 0: score all", 0.0) * 1e6);
+      s.GetDouble("score_max_latency_s", 0.0,
+                  "ATE skips scans that reached the logger later than this after their stamp "
+                  "(the logged motion capture is stamped on arrival and is late too); 0: score all",
+                  0.0) *
+      1e6);
   o.map_basename = s.GetString("map_basename", o.map_basename, "map files in output.dir: .map, .pgm/.yaml, .png, .bt");
   o.png_scale = static_cast<int>(s.GetInt("png_scale", o.png_scale, "pixels per map cell in the PNG", 1, 16));
-  o.particles_every = static_cast<int>(s.GetInt("particles_every", o.particles_every, "draw the particles every k-th scan (0: never)", 0));
-  o.publish_particles_every = static_cast<int>(s.GetInt("publish_particles_every", o.publish_particles_every,
-                                                        "emit the particles (SLAM_PARTICLES) every k-th scan (0: never)", 0));
-  o.publish_map_every = static_cast<int>(s.GetInt("publish_map_every", o.publish_map_every,
-                                                  "emit the map to later stages (planner, explorer) every k-th scan (0: never); the pose goes every scan", 0));
-  o.octomap_height_m = s.GetDouble("octomap_height_m", o.octomap_height_m, "wall height in the OctoMap .bt (0: none)", 0.0);
+  o.particles_every = static_cast<int>(
+      s.GetInt("particles_every", o.particles_every, "draw the particles every k-th scan (0: never)", 0));
+  o.publish_particles_every =
+      static_cast<int>(s.GetInt("publish_particles_every", o.publish_particles_every,
+                                "emit the particles (SLAM_PARTICLES) every k-th scan (0: never)", 0));
+  o.publish_map_every = static_cast<int>(s.GetInt(
+      "publish_map_every", o.publish_map_every,
+      "emit the map to later stages (planner, explorer) every k-th scan (0: never); the pose goes every scan", 0));
+  o.octomap_height_m =
+      s.GetDouble("octomap_height_m", o.octomap_height_m, "wall height in the OctoMap .bt (0: none)", 0.0);
   return o;
 }
 

@@ -24,12 +24,14 @@ std::vector<Pose2D> PosesOf(const std::vector<TimedPose>& s) {
 
 void WriteScansCsv(const std::string& path, const std::vector<ScanRecord>& records) {
   WriteFileAtomically(path, [&](std::ostream& o) {
-    o << "t_s,x,y,theta,filter_updated,particles,ess,spread_m,inlier_fraction,fit_ratio,injected,lost,converged,update_ms\n";
+    o << "t_s,x,y,theta,filter_updated,particles,ess,spread_m,inlier_fraction,fit_ratio,injected,lost,converged,update_"
+         "ms\n";
     char line[256];
     for (const ScanRecord& r : records) {
-      std::snprintf(line, sizeof line, "%.6f,%.4f,%.4f,%.5f,%d,%d,%.1f,%.4f,%.3f,%.3f,%d,%d,%d,%.3f\n", r.t_us * 1e-6, r.slam.x,
-                    r.slam.y, r.slam.theta, r.updated, r.status.particles, r.status.ess, r.status.spread_m,
-                    r.status.inlier_fraction, r.status.fit_ratio, r.status.injected, r.status.lost, r.status.converged, r.update_ms);
+      std::snprintf(line, sizeof line, "%.6f,%.4f,%.4f,%.5f,%d,%d,%.1f,%.4f,%.3f,%.3f,%d,%d,%d,%.3f\n", r.t_us * 1e-6,
+                    r.slam.x, r.slam.y, r.slam.theta, r.updated, r.status.particles, r.status.ess, r.status.spread_m,
+                    r.status.inlier_fraction, r.status.fit_ratio, r.status.injected, r.status.lost, r.status.converged,
+                    r.update_ms);
       o << line;
     }
   });
@@ -93,7 +95,8 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& ru
     mapping::SensorModel model(options.slam.sensor);
     model.SetMap(map);
     double sum = 0;
-    for (size_t i = 0; i < run.scan_points->size(); ++i) sum += model.InlierFraction(records[i].slam, (*run.scan_points)[i]);
+    for (size_t i = 0; i < run.scan_points->size(); ++i)
+      sum += model.InlierFraction(records[i].slam, (*run.scan_points)[i]);
     consistency = sum / run.scan_points->size();
   }
   std::vector<double> update_ms, filter_ms, ess;
@@ -105,31 +108,38 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& ru
   const double data_s = (run.last_t_us - run.first_t_us) * 1e-6;
   std::ostringstream j;
   j << "{\n  \"mode\": " << JsonString(mapping::ToString(options.slam.mode)) << ",\n  \"seed\": " << ctx.seed
-    << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"source\": " << JsonString(ctx.source_path)
-    << ",\n  \"scans\": " << records.size() << ",\n  \"scans_skipped\": " << run.skipped_scans << ",\n  \"filter_updates\": " << updates
+    << ",\n  \"interrupted\": " << (interrupted ? "true" : "false")
+    << ",\n  \"source\": " << JsonString(ctx.source_path) << ",\n  \"scans\": " << records.size()
+    << ",\n  \"scans_skipped\": " << run.skipped_scans << ",\n  \"filter_updates\": " << updates
     << ",\n  \"particles\": " << options.slam.filter.particles
-    << ",\n  \"truth\": " << JsonString(truth_series.empty() ? "none" : truth_name) << ",\n  \"scans_not_scored_late\": " << unscored_late;
+    << ",\n  \"truth\": " << JsonString(truth_series.empty() ? "none" : truth_name)
+    << ",\n  \"scans_not_scored_late\": " << unscored_late;
   if (!est_paired.empty()) {
     const motion::TrajectoryErrors slam_errors = motion::EvaluateTrajectory(est_paired, truth_paired);
     const motion::TrajectoryErrors odo_errors = motion::EvaluateTrajectory(odo_paired, truth_paired);
-    j << ",\n  \"slam_ate\": " << TrajectoryErrorsJson(slam_errors) << ",\n  \"odometry_ate\": " << TrajectoryErrorsJson(odo_errors);
-    if (!ref_paired.empty()) j << ",\n  \"reference_ate\": " << TrajectoryErrorsJson(motion::EvaluateTrajectory(ref_paired, ref_truth_paired));
+    j << ",\n  \"slam_ate\": " << TrajectoryErrorsJson(slam_errors)
+      << ",\n  \"odometry_ate\": " << TrajectoryErrorsJson(odo_errors);
+    if (!ref_paired.empty())
+      j << ",\n  \"reference_ate\": " << TrajectoryErrorsJson(motion::EvaluateTrajectory(ref_paired, ref_truth_paired));
     const motion::AteResult& a = slam_errors.aligned;
     const motion::AteResult& o = odo_errors.aligned;
-    mbot::log::Info("slam: ATE vs " + truth_name + " (aligned, " + std::to_string(a.samples) + " scans): RMSE x " + Num(a.x.rmse, 3) +
-                    " m, y " + Num(a.y.rmse, 3) + " m, xy " + Num(a.xy.rmse, 3) + " m, theta " + Num(a.theta.rmse * 180 / M_PI, 3) +
-                    " deg; odometry xy " + Num(o.xy.rmse, 3) + " m, theta " + Num(o.theta.rmse * 180 / M_PI, 3) + " deg");
+    mbot::log::Info("slam: ATE vs " + truth_name + " (aligned, " + std::to_string(a.samples) + " scans): RMSE x " +
+                    Num(a.x.rmse, 3) + " m, y " + Num(a.y.rmse, 3) + " m, xy " + Num(a.xy.rmse, 3) + " m, theta " +
+                    Num(a.theta.rmse * 180 / M_PI, 3) + " deg; odometry xy " + Num(o.xy.rmse, 3) + " m, theta " +
+                    Num(o.theta.rmse * 180 / M_PI, 3) + " deg");
   }
   const mapping::SlamEventTracker& ev = *run.events;
   j << ",\n  \"global_localization\": ";
   if (!ev.global()) {
     j << "null";
   } else {
-    j << "{\"converged\": " << (ev.converged_at_s() >= 0 ? "true" : "false") << ", \"converged_at_s\": " << Num(ev.converged_at_s())
-      << ", \"converged_at_scan\": " << ev.converged_at_scan() << "}";
+    j << "{\"converged\": " << (ev.converged_at_s() >= 0 ? "true" : "false")
+      << ", \"converged_at_s\": " << Num(ev.converged_at_s()) << ", \"converged_at_scan\": " << ev.converged_at_scan()
+      << "}";
   }
   j << ",\n  \"kidnapping\": "
-    << (run.kidnapped_at_us < 0 ? std::string("null") : "{\"at_s\": " + Num((run.kidnapped_at_us - run.first_t_us) * 1e-6) + "}");
+    << (run.kidnapped_at_us < 0 ? std::string("null")
+                                : "{\"at_s\": " + Num((run.kidnapped_at_us - run.first_t_us) * 1e-6) + "}");
   j << ",\n  \"lost\": [";
   for (size_t i = 0; i < ev.lost().size(); ++i) {
     const mapping::SlamEventTracker::Lost& l = ev.lost()[i];
@@ -142,14 +152,15 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& ru
   j << ",\n  \"effective_sample_size\": " << SampleStats::Of(ess).Json()
     << ",\n  \"timing\": {\"scan_update_ms\": " << SampleStats::Of(update_ms).Json()
     << ", \"filter_update_ms\": " << SampleStats::Of(filter_ms).Json() << ", \"wall_s\": " << Num(run.wall_s)
-    << ", \"data_s\": " << Num(data_s) << ", \"real_time_factor\": " << Num(run.wall_s > 0 ? data_s / run.wall_s : NAN) << "}"
-    << ",\n  \"map\": {\"scan_consistency\": " << Num(consistency) << ", \"width\": " << map.width() << ", \"height\": " << map.height()
-    << ", \"resolution\": " << Num(map.resolution()) << ", \"origin_x\": " << Num(map.origin_x())
-    << ", \"origin_y\": " << Num(map.origin_y()) << "}\n}\n";
+    << ", \"data_s\": " << Num(data_s) << ", \"real_time_factor\": " << Num(run.wall_s > 0 ? data_s / run.wall_s : NAN)
+    << "}"
+    << ",\n  \"map\": {\"scan_consistency\": " << Num(consistency) << ", \"width\": " << map.width()
+    << ", \"height\": " << map.height() << ", \"resolution\": " << Num(map.resolution())
+    << ", \"origin_x\": " << Num(map.origin_x()) << ", \"origin_y\": " << Num(map.origin_y()) << "}\n}\n";
   WriteFileAtomically(dir + "metrics.json", [&](std::ostream& o) { o << j.str(); });
-  mbot::log::Info("slam: " + std::to_string(records.size()) + " scans (" + std::to_string(updates) + " filter updates), scan consistency " +
-                  Num(consistency, 3) + ", median " + Num(SampleStats::Of(update_ms).median, 3) + " ms per scan; outputs in " +
-                  ctx.output_dir);
+  mbot::log::Info("slam: " + std::to_string(records.size()) + " scans (" + std::to_string(updates) +
+                  " filter updates), scan consistency " + Num(consistency, 3) + ", median " +
+                  Num(SampleStats::Of(update_ms).median, 3) + " ms per scan; outputs in " + ctx.output_dir);
 }
 
 }  // namespace mbot::app

@@ -29,7 +29,6 @@ using drivers::EventKind;
 using motion::Pose2D;
 using motion::TimedPose;
 
-
 class SlamStage : public Stage {
  public:
   explicit SlamStage(SlamStageOptions o)
@@ -81,8 +80,7 @@ class SlamStage : public Stage {
           previous_scan_us_ = ev.t_us;
         }
         break;
-      default:
-        return;
+      default: return;
     }
     ProcessReadyScans(false);
   }
@@ -96,8 +94,9 @@ class SlamStage : public Stage {
       return;
     }
     WriteSlamOutputs(ctx, interrupted,
-                     SlamRun{&options_, &slam_, &records_, &ground_truth_, &reference_, &events_, &scan_points_, &particle_snapshots_,
-                             first_t_us_, last_t_us_, perturbation_->kidnapped_at_us(), skipped_scans_, wall_s});
+                     SlamRun{&options_, &slam_, &records_, &ground_truth_, &reference_, &events_, &scan_points_,
+                             &particle_snapshots_, first_t_us_, last_t_us_, perturbation_->kidnapped_at_us(),
+                             skipped_scans_, wall_s});
   }
 
  private:
@@ -170,10 +169,11 @@ class SlamStage : public Stage {
   void ProcessScan(const Pending& p, int64_t t_end, const std::vector<TimedPose>& poses) {
     const drivers::LidarScan& scan = p.scan;
     // When was each beam measured, as a fraction of the scan's duration?
-    const mapping::BeamTimes beams =
-        mapping::TimeBeams(options_.beam_timing, scan.angles_rad, scan.beam_times_us, p.previous_us >= 0 ? p.t_us - p.previous_us : 0);
+    const mapping::BeamTimes beams = mapping::TimeBeams(options_.beam_timing, scan.angles_rad, scan.beam_times_us,
+                                                        p.previous_us >= 0 ? p.t_us - p.previous_us : 0);
     if (beams.beam_times_unusable) {
-      mbot::log::WarnOnce("slam:beam_times", "slam: beam_timing = beams, but this scan's beam times do not span the scan");
+      mbot::log::WarnOnce("slam:beam_times",
+                          "slam: beam_timing = beams, but this scan's beam times do not span the scan");
     }
     const std::vector<float>& fractions = beams.fractions;
     const int64_t duration = beams.duration_us;
@@ -230,10 +230,12 @@ class SlamStage : public Stage {
     }
     if (options_.publish_particles_every > 0 && records_.size() % options_.publish_particles_every == 0) {
       drivers::Particles p;
-      for (const mapping::Particle& q : slam_.filter().particles()) p.poses.push_back(q.pose), p.weights.push_back(q.weight);
+      for (const mapping::Particle& q : slam_.filter().particles())
+        p.poses.push_back(q.pose), p.weights.push_back(q.weight);
       bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_PARTICLES", EventKind::kParticles, std::move(p)});
     }
-    if (options_.publish_map_every > 0 && (records_.size() == 1 || (builds_map && records_.size() % options_.publish_map_every == 0))) {
+    if (options_.publish_map_every > 0 &&
+        (records_.size() == 1 || (builds_map && records_.size() % options_.publish_map_every == 0))) {
       bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_MAP", EventKind::kMap,
                                       std::make_shared<const mapping::OccupancyGrid>(slam_.map())});
     }
@@ -265,7 +267,8 @@ class SlamStage : public Stage {
 
   // Global-localization convergence and kidnapping: when lost was flagged, when the filter recovered.
   void TrackEvents(const ScanRecord& r) {
-    const std::string said = events_.Add((r.t_us - first_t_us_) * 1e-6, static_cast<int>(records_.size()) - 1, r.updated, r.status);
+    const std::string said =
+        events_.Add((r.t_us - first_t_us_) * 1e-6, static_cast<int>(records_.size()) - 1, r.updated, r.status);
     if (!said.empty()) mbot::log::Info("slam: " + said);
   }
 
@@ -297,7 +300,9 @@ StageType SlamStageType() {
   return {"slam",
           "log-odds mapping, Monte-Carlo localization and full SLAM (mode = full_slam | localization | "
           "mapping_only | action_only); writes the map, TUM trajectories and metrics.json",
-          [](config::Section& s) -> std::unique_ptr<Stage> { return std::make_unique<SlamStage>(ParseSlamStageOptions(s)); }};
+          [](config::Section& s) -> std::unique_ptr<Stage> {
+            return std::make_unique<SlamStage>(ParseSlamStageOptions(s));
+          }};
 }
 
 }  // namespace mbot::app

@@ -35,8 +35,9 @@ class TrajectoryWriterStage : public Stage {
     Track& track = tracks_[ev.kind];
     if (track.channel.empty()) track.channel = ev.channel;
     if (track.channel != ev.channel) {
-      mbot::log::WarnOnce("trajectory_writer:" + ev.channel, "trajectory_writer: " + std::string(drivers::ToString(ev.kind)) +
-                                                               " channel " + ev.channel + " ignored; writing " + track.channel);
+      mbot::log::WarnOnce("trajectory_writer:" + ev.channel,
+                          "trajectory_writer: " + std::string(drivers::ToString(ev.kind)) + " channel " + ev.channel +
+                              " ignored; writing " + track.channel);
       return;
     }
     track.text += TumLine(ev.t_us * 1e-6, pose->x, pose->y, pose->theta);
@@ -73,7 +74,8 @@ StageType TrajectoryWriterStageType() {
   return {"trajectory_writer", "writes the odometry, ground-truth and reference pose channels as TUM trajectories",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             TrajectoryWriterOptions o;
-            o.odometry_file = s.GetString("odometry_file", o.odometry_file, "odometry trajectory in output.dir ('' for none)");
+            o.odometry_file =
+                s.GetString("odometry_file", o.odometry_file, "odometry trajectory in output.dir ('' for none)");
             o.ground_truth_file = s.GetString("ground_truth_file", o.ground_truth_file,
                                               "ground-truth trajectory in output.dir ('' for none)");
             o.reference_file = s.GetString("reference_file", o.reference_file,

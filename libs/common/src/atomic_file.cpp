@@ -14,8 +14,7 @@ namespace mbot {
 
 std::string TempPathFor(const std::string& path) {
   const fs::path p(path);
-  return (p.parent_path() / (".tmp." + std::to_string(::getpid()) + "." + p.filename().string()))
-      .string();
+  return (p.parent_path() / (".tmp." + std::to_string(::getpid()) + "." + p.filename().string())).string();
 }
 
 void CommitFile(const std::string& tmp, const std::string& path) {

@@ -60,8 +60,7 @@ Config Config::Load(const std::string& path) {
   return c;
 }
 
-Config Config::FromString(const std::string& text, const std::string& name,
-                          const std::string& base_dir) {
+Config Config::FromString(const std::string& text, const std::string& name, const std::string& base_dir) {
   Config c;
   c.main_file_ = name;
   std::vector<std::string> stack{name};
@@ -85,11 +84,11 @@ void Config::ParseFile(const std::string& path, std::vector<std::string>& stack)
   stack.pop_back();
 }
 
-void Config::ParseText(const std::string& text, const std::string& file,
-                       const std::string& base_dir, std::vector<std::string>& stack) {
+void Config::ParseText(const std::string& text, const std::string& file, const std::string& base_dir,
+                       std::vector<std::string>& stack) {
   std::istringstream in(text);
   std::string raw;
-  std::string section;  // empty until the first [section]
+  std::string section;                                          // empty until the first [section]
   std::map<std::string, std::map<std::string, int>> seen_here;  // duplicate detection per file
   int line_no = 0;
   while (std::getline(in, raw)) {
@@ -187,9 +186,7 @@ Section::Section(std::string name, const std::map<std::string, Entry>* entries, 
 
 Section Section::Describe(std::string name) { return Section(std::move(name), nullptr); }
 
-bool Section::Has(const std::string& key) const {
-  return entries_ && entries_->count(key) > 0;
-}
+bool Section::Has(const std::string& key) const { return entries_ && entries_->count(key) > 0; }
 
 void Section::Accept(const std::string& key) { known_.push_back(key); }
 
@@ -201,8 +198,8 @@ void Section::Fail(const std::string& key, const std::string& message) const {
   throw ConfigError(where + "[" + name_ + "] " + key + ": " + message);
 }
 
-const Entry* Section::Find(const std::string& key, const std::string& type, const std::string& def,
-                           bool required, const std::string& doc) {
+const Entry* Section::Find(const std::string& key, const std::string& type, const std::string& def, bool required,
+                           const std::string& doc) {
   known_.push_back(key);
   if (describing()) {
     docs_.push_back(KeyDoc{key, type, def, required, doc});
@@ -210,7 +207,9 @@ const Entry* Section::Find(const std::string& key, const std::string& type, cons
   }
   auto it = entries_->find(key);
   if (it == entries_->end()) {
-    if (required) throw ConfigError((file_.empty() ? "" : file_ + ": ") + "[" + name_ + "] " + key + ": required key is missing (" + doc + ")");
+    if (required)
+      throw ConfigError((file_.empty() ? "" : file_ + ": ") + "[" + name_ + "] " + key + ": required key is missing (" +
+                        doc + ")");
     return nullptr;
   }
   return &it->second;
@@ -261,8 +260,7 @@ std::string Section::RequirePath(const std::string& key, const std::string& doc)
   return e ? Expand(*e, key) : "";
 }
 
-long long Section::GetInt(const std::string& key, long long def, const std::string& doc,
-                          long long min, long long max) {
+long long Section::GetInt(const std::string& key, long long def, const std::string& doc, long long min, long long max) {
   const Entry* e = Find(key, "int", std::to_string(def), false, doc);
   if (!e) return def;
   errno = 0;
@@ -277,8 +275,7 @@ long long Section::GetInt(const std::string& key, long long def, const std::stri
   return v;
 }
 
-double Section::GetDouble(const std::string& key, double def, const std::string& doc, double min,
-                          double max) {
+double Section::GetDouble(const std::string& key, double def, const std::string& doc, double min, double max) {
   std::ostringstream d;
   d << def;
   const Entry* e = Find(key, "double", d.str(), false, doc);
@@ -334,7 +331,8 @@ std::vector<PoseValue> Section::GetPoses(const std::string& key, const std::vect
                                          const std::string& doc) {
   std::vector<std::string> texts;
   for (const PoseValue& p : def) texts.push_back(PoseText(p));
-  const Entry* e = Find(key, "poses", Join(texts, "; "), false, doc + " (x, y, theta_deg per pose; poses separated by ';')");
+  const Entry* e =
+      Find(key, "poses", Join(texts, "; "), false, doc + " (x, y, theta_deg per pose; poses separated by ';')");
   if (!e) return def;
   std::string text = e->value;
   std::replace(text.begin(), text.end(), ';', ',');
@@ -355,7 +353,8 @@ std::vector<PoseValue> Section::GetPoses(const std::string& key, const std::vect
     Fail(key, std::to_string(numbers.size()) + " numbers do not make x, y, theta_deg triples");
   }
   std::vector<PoseValue> poses;
-  for (size_t i = 0; i + 2 < numbers.size(); i += 3) poses.push_back({numbers[i], numbers[i + 1], numbers[i + 2] * M_PI / 180.0});
+  for (size_t i = 0; i + 2 < numbers.size(); i += 3)
+    poses.push_back({numbers[i], numbers[i + 1], numbers[i + 2] * M_PI / 180.0});
   return poses;
 }
 
@@ -365,8 +364,8 @@ PoseValue Section::GetPose(const std::string& key, const PoseValue& def, const s
   return poses[0];
 }
 
-std::string Section::GetChoice(const std::string& key, const std::string& def,
-                               const std::vector<std::string>& choices, const std::string& doc) {
+std::string Section::GetChoice(const std::string& key, const std::string& def, const std::vector<std::string>& choices,
+                               const std::string& doc) {
   const Entry* e = Find(key, "string", def, false, doc + " (one of: " + Join(choices, ", ") + ")");
   if (!e) return def;
   if (std::find(choices.begin(), choices.end(), e->value) == choices.end()) {

@@ -75,8 +75,7 @@ void CarmenSource::GuessBeamGeometry(int n, double* start, double* inc) {
   *start = -fov / 2.0;
 }
 
-CarmenSource::CarmenSource(const SourceOptions& options)
-    : options_(options), max_range_m_(options.carmen_max_range_m) {
+CarmenSource::CarmenSource(const SourceOptions& options) : options_(options), max_range_m_(options.carmen_max_range_m) {
   gzFile f = gzopen(options.path.c_str(), "rb");
   if (!f) throw std::runtime_error(options.path + ": cannot open CARMEN log");
   std::string line;
@@ -219,9 +218,7 @@ std::optional<Event> CarmenSource::Next() {
   return std::move(events_[next_++]);
 }
 
-double CarmenSource::Progress() const {
-  return events_.empty() ? 1.0 : double(next_) / double(events_.size());
-}
+double CarmenSource::Progress() const { return events_.empty() ? 1.0 : double(next_) / double(events_.size()); }
 
 std::vector<std::pair<std::string, std::string>> CarmenSource::Details() const {
   return {{"lines", std::to_string(lines_)},

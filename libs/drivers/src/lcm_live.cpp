@@ -18,7 +18,8 @@ constexpr int64_t kLatestPlausibleUs = 4'102'444'800'000'000;  // 2100-01-01 in 
 }  // namespace
 
 int64_t WallClockUs() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
 }
 
 struct LcmNode::Impl {
@@ -41,7 +42,8 @@ struct LcmNode::Impl {
     if (!lcm_adapter::LookUp(lcm_adapter::Fingerprint(data, size))) {
       ++s.unknown;
       s.last_error = "unknown fingerprint (or a packet shorter than one)";
-      mbot::log::WarnOnce("lcm_live:unknown:" + channel, "lcm: " + channel + ": message of an unknown type, skipped (counted)");
+      mbot::log::WarnOnce("lcm_live:unknown:" + channel,
+                          "lcm: " + channel + ": message of an unknown type, skipped (counted)");
       return;
     }
     Event ev;
@@ -49,8 +51,8 @@ struct LcmNode::Impl {
     if (!lcm_adapter::Decode(channel, data, size, node->roles_, &ev, &error)) {
       ++s.rejected;
       s.last_error = error;
-      mbot::log::WarnOnce("lcm_live:rejected:" + channel, "lcm: " + channel + ": malformed message rejected (" + error +
-                                                              "); further ones are counted");
+      mbot::log::WarnOnce("lcm_live:rejected:" + channel,
+                          "lcm: " + channel + ": malformed message rejected (" + error + "); further ones are counted");
       return;
     }
     // utime is µs on the robot's clock (since boot, or the epoch once time-synced): below zero or
@@ -58,7 +60,8 @@ struct LcmNode::Impl {
     if (ev.stamp_us < 0 || ev.stamp_us > kLatestPlausibleUs) {
       ++s.rejected;
       s.last_error = "absurd timestamp utime = " + std::to_string(ev.stamp_us);
-      mbot::log::WarnOnce("lcm_live:time:" + channel, "lcm: " + channel + ": " + s.last_error + "; rejected (further ones are counted)");
+      mbot::log::WarnOnce("lcm_live:time:" + channel,
+                          "lcm: " + channel + ": " + s.last_error + "; rejected (further ones are counted)");
       return;
     }
     ev.channel = channel;
@@ -74,7 +77,8 @@ LcmNode::LcmNode(const std::string& url, const std::vector<std::string>& channel
   for (const std::string& c : channels) {
     // LCM takes the name as a regular expression: anchor it to this channel alone.
     std::string exact;
-    for (const char ch : c) exact += std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' ? std::string(1, ch) : std::string("\\") + ch;
+    for (const char ch : c)
+      exact += std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' ? std::string(1, ch) : std::string("\\") + ch;
     if (!impl_->lcm.subscribe(exact, &Impl::OnMessage, impl_.get())) {
       throw std::runtime_error("lcm: cannot subscribe to '" + c + "' on '" + url + "'");
     }
@@ -110,7 +114,8 @@ bool LcmNode::PublishRaw(const std::string& channel, const std::vector<uint8_t>&
   }
   ++stats_[channel].published;
   if (subscribed(channel)) {  // remember it, to know its echo
-    const size_t h = std::hash<std::string_view>()(std::string_view(reinterpret_cast<const char*>(data.data()), data.size()));
+    const size_t h =
+        std::hash<std::string_view>()(std::string_view(reinterpret_cast<const char*>(data.data()), data.size()));
     auto& recent = recent_[channel];
     recent.push_back(h);
     if (recent.size() > kRecentPerChannel) recent.pop_front();

@@ -22,7 +22,8 @@ LcmLiveSource::LcmLiveSource(const SourceOptions& options)
     : o_(options.live), node_(options.path, options.live.channels, options.roles) {
   start_ = last_message_ = last_report_ = last_zero_ = Clock::now();
   for (const std::string& c : o_.watched) last_seen_[c] = start_;
-  for (const std::string& c : o_.channels) channels_[c] = ChannelInfo{"mbot_lcm_msgs", "2023+", EventKind::kOther, true};
+  for (const std::string& c : o_.channels)
+    channels_[c] = ChannelInfo{"mbot_lcm_msgs", "2023+", EventKind::kOther, true};
   mbot::log::Info("lcm: listening on " + options.path + " to " + std::to_string(o_.channels.size()) + " channels");
 }
 
@@ -78,8 +79,8 @@ void LcmLiveSource::Watchdog(Clock::time_point now) {
   if (!silent.empty() && !halted_) {
     halted_ = true;
     ++halts_;
-    mbot::log::Warn("lcm: no " + silent + " for " + Fixed(o_.stale_sensor_s, 1) + " s: robot stopped (zero velocity on " +
-                    o_.command_channel + ") until it is back");
+    mbot::log::Warn("lcm: no " + silent + " for " + Fixed(o_.stale_sensor_s, 1) +
+                    " s: robot stopped (zero velocity on " + o_.command_channel + ") until it is back");
   } else if (silent.empty() && halted_) {
     halted_ = false;
     mbot::log::Info("lcm: sensors back: commands pass again");
@@ -137,9 +138,11 @@ std::vector<std::pair<std::string, std::string>> LcmLiveSource::Details() const 
       {"sensor stops", std::to_string(halts_)},
       {"commands held back", std::to_string(held_commands_)},
       {"loop rate", Fixed(last_rate_hz_, 1) + " messages/s"},
-      {"latency", "median " + Fixed(last_latency_median_ms_, 2) + " ms, max " + Fixed(last_latency_max_ms_, 2) + " ms"}};
+      {"latency",
+       "median " + Fixed(last_latency_median_ms_, 2) + " ms, max " + Fixed(last_latency_max_ms_, 2) + " ms"}};
   for (const auto& [channel, s] : node_.stats()) {
-    if (s.rejected + s.unknown > 0) d.push_back({"rejected on " + channel, std::to_string(s.rejected + s.unknown) + " (" + s.last_error + ")"});
+    if (s.rejected + s.unknown > 0)
+      d.push_back({"rejected on " + channel, std::to_string(s.rejected + s.unknown) + " (" + s.last_error + ")"});
     if (s.own_echoes > 0) d.push_back({"own messages looped back on " + channel, std::to_string(s.own_echoes)});
   }
   return d;

@@ -40,7 +40,7 @@ class LcmLiveSource : public Source, public Sink {
   static Clock::duration Seconds(double s) {
     return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
   }
-  static constexpr double kZeroRateHz = 10.0;          // zero velocity while halted
+  static constexpr double kZeroRateHz = 10.0;           // zero velocity while halted
   static constexpr size_t kMaxLatencySamples = 100000;  // a report (and a fresh window) at the latest then
 
   void Watchdog(Clock::time_point now);

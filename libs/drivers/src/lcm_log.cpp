@@ -59,8 +59,8 @@ bool LcmLogReader::Resync(int64_t from) {
     pos += got - 3;
   }
   skipped_bytes_ += size_ - from;
-  mbot::log::Warn(path_ + ": no sync word after byte " + std::to_string(from) + "; " +
-                  std::to_string(size_ - from) + " trailing bytes ignored");
+  mbot::log::Warn(path_ + ": no sync word after byte " + std::to_string(from) + "; " + std::to_string(size_ - from) +
+                  " trailing bytes ignored");
   pos_ = size_;
   return false;
 }
@@ -120,8 +120,8 @@ std::optional<LcmLogRecord> LcmLogReader::Next() {
   return std::nullopt;
 }
 
-void AppendLcmRecord(std::vector<uint8_t>& out, int64_t event_number, int64_t timestamp_us,
-                     const std::string& channel, const std::vector<uint8_t>& data) {
+void AppendLcmRecord(std::vector<uint8_t>& out, int64_t event_number, int64_t timestamp_us, const std::string& channel,
+                     const std::vector<uint8_t>& data) {
   PutU32(out, LcmLogReader::kSyncWord);
   PutI64(out, event_number);
   PutI64(out, timestamp_us);

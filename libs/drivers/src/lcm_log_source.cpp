@@ -52,8 +52,8 @@ std::optional<Event> LcmLogSource::ReadOne() {
     }
     info.kind = ev.kind;
     if (ev.kind == EventKind::kGroundTruth &&
-        std::find(options_.roles.rezero_ground_truth.begin(), options_.roles.rezero_ground_truth.end(),
-                  rec->channel) != options_.roles.rezero_ground_truth.end()) {
+        std::find(options_.roles.rezero_ground_truth.begin(), options_.roles.rezero_ground_truth.end(), rec->channel) !=
+            options_.roles.rezero_ground_truth.end()) {
       auto& pose = std::get<motion::Pose2D>(ev.payload);
       auto [it, first] = rezero_origin_.emplace(rec->channel, pose);
       // Subtract the first pose and rotate by -θ0, so ground truth starts at the origin like odometry.

@@ -39,8 +39,8 @@ int64_t Fingerprint(const uint8_t* data, size_t size);
 
 namespace {
 
-using Decoder = std::function<bool(const std::string& channel, const uint8_t*, size_t, const ChannelRoles&,
-                                   Event*, std::string*)>;
+using Decoder =
+    std::function<bool(const std::string& channel, const uint8_t*, size_t, const ChannelRoles&, Event*, std::string*)>;
 
 struct Entry {
   TypeInfo info;
@@ -61,8 +61,8 @@ bool CheckCount(const uint8_t* data, size_t size, size_t offset, size_t element_
   }
   const int32_t n = ReadI32(data + offset);
   if (n < 0 || uint64_t(n) * element_bytes > size - offset - 4) {
-    *error = std::string(field) + " = " + std::to_string(n) + " disagrees with the payload (" +
-             std::to_string(size) + " bytes)";
+    *error = std::string(field) + " = " + std::to_string(n) + " disagrees with the payload (" + std::to_string(size) +
+             " bytes)";
     return false;
   }
   return true;
@@ -131,10 +131,14 @@ bool DecodePose(const std::string& channel, const uint8_t* d, size_t n, const Ch
   }
   ev->stamp_us = m.utime;
   ev->payload = motion::Pose2D{m.x, m.y, m.theta};
-  if (In(roles.ground_truth, channel)) ev->kind = EventKind::kGroundTruth;
-  else if (In(roles.odometry, channel)) ev->kind = EventKind::kOdometry;
-  else if (In(roles.reference_pose, channel)) ev->kind = EventKind::kReferencePose;
-  else ev->kind = EventKind::kOther;
+  if (In(roles.ground_truth, channel))
+    ev->kind = EventKind::kGroundTruth;
+  else if (In(roles.odometry, channel))
+    ev->kind = EventKind::kOdometry;
+  else if (In(roles.reference_pose, channel))
+    ev->kind = EventKind::kReferencePose;
+  else
+    ev->kind = EventKind::kOther;
   return true;
 }
 
@@ -143,8 +147,8 @@ bool DecodeGrid(const uint8_t* d, size_t n, size_t count_offset, Event* ev, std:
   if (!CheckCount(d, n, count_offset, 1, "num_cells", err)) return false;
   Grid m{};
   if (!DecodeExact(d, n, &m, err)) return false;
-  if (m.width < 0 || m.height < 0 || int64_t(m.width) * m.height != m.num_cells ||
-      !(m.meters_per_cell > 0.0f) || !std::isfinite(m.origin_x) || !std::isfinite(m.origin_y)) {
+  if (m.width < 0 || m.height < 0 || int64_t(m.width) * m.height != m.num_cells || !(m.meters_per_cell > 0.0f) ||
+      !std::isfinite(m.origin_x) || !std::isfinite(m.origin_y)) {
     *err = "grid " + std::to_string(m.width) + "x" + std::to_string(m.height) + " does not match num_cells " +
            std::to_string(m.num_cells) + " or has a bad resolution/origin";
     return false;
@@ -173,9 +177,9 @@ Decoder Other(size_t count_offset = 0, size_t element_bytes = 0, const char* fie
 
 // exploration_status_t's STATE_* and STATUS_* constants by value, as this stack's state names.
 // exploration_status_t's states, in the order of its constants, as the mission's states.
-constexpr mission::MissionState kExplorationStates[] = {mission::MissionState::kInitializing, mission::MissionState::kExploring,
-                                                       mission::MissionState::kReturningHome, mission::MissionState::kCompleted,
-                                                       mission::MissionState::kFailed};
+constexpr mission::MissionState kExplorationStates[] = {
+    mission::MissionState::kInitializing, mission::MissionState::kExploring, mission::MissionState::kReturningHome,
+    mission::MissionState::kCompleted, mission::MissionState::kFailed};
 const char* const kExplorationStatuses[] = {"in progress", "complete", "failed"};
 
 std::map<int64_t, Entry> BuildTable() {
@@ -191,8 +195,9 @@ std::map<int64_t, Entry> BuildTable() {
   };
   const std::string kLegacy = "legacy 2017-2022", kW23 = "W23", kCurrent = "2023+", kMaebot = "Maebot";
 
-  Decoder lidar = [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev,
-                     std::string* err) { return DecodeLidar<mbot_legacy::lidar_t>(d, n, ev, err); };
+  Decoder lidar = [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+    return DecodeLidar<mbot_legacy::lidar_t>(d, n, ev, err);
+  };
   add(mbot_legacy::lidar_t::getHash(), "lidar_t", kLegacy, lidar);
   add(mbot_legacy::lidar_t::getHash(), "lidar_t", kW23, lidar);
   add(mbot_legacy::lidar_t::getHash(), "lidar_t", kCurrent, lidar);
@@ -358,7 +363,8 @@ std::map<int64_t, Entry> BuildTable() {
         return DecodeGrid<mbot_w23::occupancy_grid_t>(d, n, 36, ev, err);
       });
 
-  add(mbot_legacy::particles_t::getHash(), "particles_t", kLegacy, Other<mbot_legacy::particles_t>(16, 48, "num_particles"));
+  add(mbot_legacy::particles_t::getHash(), "particles_t", kLegacy,
+      Other<mbot_legacy::particles_t>(16, 48, "num_particles"));
   add(mbot_legacy::particles_t::getHash(), "particles_t", kW23, nullptr);
   add(mbot_legacy::particles_t::getHash(), "particles_t", kCurrent, nullptr);
   add(mbot_legacy::robot_path_t::getHash(), "robot_path_t", kLegacy,
@@ -383,16 +389,19 @@ std::map<int64_t, Entry> BuildTable() {
   add(mbot_legacy::timestamp_t::getHash(), "timestamp_t", kLegacy, Other<mbot_legacy::timestamp_t>());
   add(mbot_legacy::timestamp_t::getHash(), "timestamp_t", kW23, nullptr);
   add(mbot_legacy::timestamp_t::getHash(), "timestamp_t", kCurrent, nullptr);
-  add(mbot_legacy::message_received_t::getHash(), "message_received_t", kLegacy, Other<mbot_legacy::message_received_t>());
+  add(mbot_legacy::message_received_t::getHash(), "message_received_t", kLegacy,
+      Other<mbot_legacy::message_received_t>());
   add(mbot_legacy::message_received_t::getHash(), "mbot_message_received_t", kCurrent, nullptr);
-  add(mbot_legacy::exploration_status_t::getHash(), "exploration_status_t", kLegacy, Other<mbot_legacy::exploration_status_t>());
+  add(mbot_legacy::exploration_status_t::getHash(), "exploration_status_t", kLegacy,
+      Other<mbot_legacy::exploration_status_t>());
   add(mbot_legacy::exploration_status_t::getHash(), "exploration_status_t", kW23, nullptr);
   add(mbot_lcm_msgs::exploration_status_t::getHash(), "exploration_status_t", kCurrent,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
         mbot_lcm_msgs::exploration_status_t m{};
         if (!DecodeExact(d, n, &m, err)) return false;
         if (m.state < 0 || m.state > 4 || m.status < 0 || m.status > 2) {
-          *err = "state " + std::to_string(m.state) + " / status " + std::to_string(m.status) + " is not one of the botlab's";
+          *err = "state " + std::to_string(m.state) + " / status " + std::to_string(m.status) +
+                 " is not one of the botlab's";
           return false;
         }
         ev->kind = EventKind::kMissionStatus;
@@ -401,7 +410,8 @@ std::map<int64_t, Entry> BuildTable() {
         return true;
       });
   add(mbot_lcm_msgs::slam_status_t::getHash(), "slam_status_t", kCurrent, Other<mbot_lcm_msgs::slam_status_t>());
-  add(mbot_lcm_msgs::mbot_slam_reset_t::getHash(), "mbot_slam_reset_t", kCurrent, Other<mbot_lcm_msgs::mbot_slam_reset_t>());
+  add(mbot_lcm_msgs::mbot_slam_reset_t::getHash(), "mbot_slam_reset_t", kCurrent,
+      Other<mbot_lcm_msgs::mbot_slam_reset_t>());
   add(mbot_w23::mbot_system_reset_t::getHash(), "mbot_system_reset_t", kW23, nullptr);
   return t;
 }
@@ -556,7 +566,8 @@ bool Encode(const Event& ev, std::vector<uint8_t>* out) {
       m.utime = ev.stamp_us;
       for (size_t i = 0; i < p.poses.size(); ++i) {
         mbot_legacy::particle_t q{};
-        q.pose = {ev.stamp_us, static_cast<float>(p.poses[i].x), static_cast<float>(p.poses[i].y), static_cast<float>(p.poses[i].theta)};
+        q.pose = {ev.stamp_us, static_cast<float>(p.poses[i].x), static_cast<float>(p.poses[i].y),
+                  static_cast<float>(p.poses[i].theta)};
         q.parent_pose = q.pose;
         q.weight = i < p.weights.size() ? p.weights[i] : 0.0;
         m.particles.push_back(q);
@@ -571,7 +582,7 @@ bool Encode(const Event& ev, std::vector<uint8_t>* out) {
       const auto& st = std::get<mapping::SlamStatus>(ev.payload);
       mbot_lcm_msgs::slam_status_t m{};
       m.utime = ev.stamp_us;
-      m.slam_mode = st.mode == mapping::SlamMode::kMappingOnly   ? 0
+      m.slam_mode = st.mode == mapping::SlamMode::kMappingOnly    ? 0
                     : st.mode == mapping::SlamMode::kActionOnly   ? 1
                     : st.mode == mapping::SlamMode::kLocalization ? 2
                                                                   : 3;
@@ -595,8 +606,7 @@ bool Encode(const Event& ev, std::vector<uint8_t>* out) {
       EncodeMessage(m, out);
       return true;
     }
-    default:
-      return false;
+    default: return false;
   }
 }
 

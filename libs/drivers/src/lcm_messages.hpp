@@ -25,15 +25,15 @@ const TypeInfo* LookUp(int64_t fingerprint);
 // Decodes one message into `event` (kind, stamp_us, payload; t_us and channel are set by the
 // caller). Returns false with `error` set when the message is malformed: a count that disagrees
 // with the payload length, trailing bytes, non-finite poses. Never reads out of bounds.
-bool Decode(const std::string& channel, const uint8_t* data, size_t size, const ChannelRoles& roles,
-            Event* event, std::string* error);
+bool Decode(const std::string& channel, const uint8_t* data, size_t size, const ChannelRoles& roles, Event* event,
+            std::string* error);
 
 // Encodes an event as the current (2023+) mbot_lcm_msgs message the botlab publishes on its
 // channel: lidar_t (angles clockwise again), pose2D_t for every pose kind, mbot_encoders_t,
 // mbot_imu_t, twist2D_t (velocity commands), mbot_motor_pwm_t, mbot_motor_vel_t, occupancy_grid_t
 // (maps), path2D_t (paths), particles_t, slam_status_t (kSlamStatus) and
-// exploration_status_t (kMissionStatus: the task's state as the botlab's constants). Returns false, leaving `out` empty,
-// for kinds that have no such message (calibration samples, plan requests, others).
+// exploration_status_t (kMissionStatus: the task's state as the botlab's constants). Returns false, leaving `out`
+// empty, for kinds that have no such message (calibration samples, plan requests, others).
 bool Encode(const Event& event, std::vector<uint8_t>* out);
 
 // All registered fingerprints (for tests and --list-types).

@@ -1,6 +1,5 @@
 #include "mbot/drivers/map_io.hpp"
 
-
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/maps/CSimpleMap.h>
@@ -44,7 +43,8 @@ mapping::OccupancyGrid ReadBotlabMap(const std::string& path) {
   if (!in) Fail(path, "cannot open map");
   double ox, oy, res;
   long long w, h;
-  if (!(in >> ox >> oy >> w >> h >> res)) Fail(path, "line 1: expected 'origin_x origin_y width height meters_per_cell'");
+  if (!(in >> ox >> oy >> w >> h >> res))
+    Fail(path, "line 1: expected 'origin_x origin_y width height meters_per_cell'");
   if (w <= 0 || h <= 0 || w * h > (1LL << 31) || !(res > 0) || !std::isfinite(ox) || !std::isfinite(oy)) {
     Fail(path, "line 1: implausible header (" + std::to_string(w) + "x" + std::to_string(h) + ", resolution " +
                    ShortestDouble(res) + ")");
@@ -54,10 +54,11 @@ mapping::OccupancyGrid ReadBotlabMap(const std::string& path) {
     for (long long x = 0; x < w; ++x) {
       int v;
       if (!(in >> v)) {
-        Fail(path, "line " + std::to_string(y + 2) + ": expected " + std::to_string(w) + " cells, file ends or has a non-number at cell " +
-                       std::to_string(x));
+        Fail(path, "line " + std::to_string(y + 2) + ": expected " + std::to_string(w) +
+                       " cells, file ends or has a non-number at cell " + std::to_string(x));
       }
-      if (v < -128 || v > 127) Fail(path, "line " + std::to_string(y + 2) + ": cell value " + std::to_string(v) + " outside int8");
+      if (v < -128 || v > 127)
+        Fail(path, "line " + std::to_string(y + 2) + ": cell value " + std::to_string(v) + " outside int8");
       grid.at(static_cast<int>(x), static_cast<int>(y)) = static_cast<int8_t>(std::max(v, -127));
     }
   }
@@ -68,8 +69,8 @@ mapping::OccupancyGrid ReadBotlabMap(const std::string& path) {
 
 void WriteBotlabMap(const mapping::OccupancyGrid& g, const std::string& path) {
   WriteFileAtomically(path, [&](std::ostream& out) {
-    out << ShortestDouble(g.origin_x()) << ' ' << ShortestDouble(g.origin_y()) << ' ' << g.width() << ' '
-        << g.height() << ' ' << ShortestDouble(g.resolution()) << '\n';
+    out << ShortestDouble(g.origin_x()) << ' ' << ShortestDouble(g.origin_y()) << ' ' << g.width() << ' ' << g.height()
+        << ' ' << ShortestDouble(g.resolution()) << '\n';
     std::string row;
     for (int y = 0; y < g.height(); ++y) {
       row.clear();
@@ -133,7 +134,8 @@ mapping::OccupancyGrid ReadRosMap(const std::string& yaml_path) {
   if (image.empty()) Fail(yaml_path, "missing key 'image'");
   if (!have_res || !(res > 0)) Fail(yaml_path, "missing or bad 'resolution'");
   if (!have_origin) Fail(yaml_path, "missing 'origin'");
-  if (std::abs(yaw) > 1e-9) Fail(yaml_path, "origin yaw " + ShortestDouble(yaw) + " is not supported (only axis-aligned maps)");
+  if (std::abs(yaw) > 1e-9)
+    Fail(yaml_path, "origin yaw " + ShortestDouble(yaw) + " is not supported (only axis-aligned maps)");
   if (mode != "trinary" && mode != "scale") Fail(yaml_path, "mode '" + mode + "' is not supported (trinary, scale)");
   const fs::path img_path = fs::path(image).is_absolute() ? fs::path(image) : fs::path(yaml_path).parent_path() / image;
   cv::Mat img = cv::imread(img_path.string(), cv::IMREAD_GRAYSCALE);
@@ -146,8 +148,10 @@ mapping::OccupancyGrid ReadRosMap(const std::string& yaml_path) {
       const int p = negate ? 255 - row[x] : row[x];
       const double occ = (255.0 - p) / 255.0;
       int8_t v = 0;
-      if (occ > occ_th) v = static_cast<int8_t>(std::clamp(127 - p, 1, 127));
-      else if (occ < free_th) v = static_cast<int8_t>(std::clamp(127 - p, -127, -1));
+      if (occ > occ_th)
+        v = static_cast<int8_t>(std::clamp(127 - p, 1, 127));
+      else if (occ < free_th)
+        v = static_cast<int8_t>(std::clamp(127 - p, -127, -1));
       grid.at(x, y) = v;
     }
   }
@@ -232,13 +236,14 @@ mapping::OccupancyGrid ReadMrptSimplemap(const std::string& path, double resolut
       if (!mrpt_scan) continue;
       const LidarScan scan = FromMrptScan(*mrpt_scan);
       const std::vector<float> fractions(scan.ranges_m.size(), 1.0f);  // a keyframe's scan has one pose
-      mapper.Insert(mapping::DeskewScan(scan.ranges_m, scan.angles_rad, fractions, {}, scan.sensor_pose, scan.max_range_m,
-                                        scan_options),
+      mapper.Insert(mapping::DeskewScan(scan.ranges_m, scan.angles_rad, fractions, {}, scan.sensor_pose,
+                                        scan.max_range_m, scan_options),
                     robot);
       ++scans;
     }
   }
-  if (scans == 0) Fail(path, "holds no 2D range scans to build a grid from (" + std::to_string(sm.size()) + " keyframes)");
+  if (scans == 0)
+    Fail(path, "holds no 2D range scans to build a grid from (" + std::to_string(sm.size()) + " keyframes)");
   return mapper.map();
 }
 
@@ -252,10 +257,14 @@ mapping::OccupancyGrid ReadMovingAiMap(const std::string& path) {
     std::istringstream s(Trim(line));
     s >> word;
     if (word == "type") continue;
-    if (word == "height") s >> h;
-    else if (word == "width") s >> w;
-    else if (word == "map") break;
-    else Fail(path, "line " + std::to_string(line_no) + ": unexpected header '" + Trim(line) + "'");
+    if (word == "height")
+      s >> h;
+    else if (word == "width")
+      s >> w;
+    else if (word == "map")
+      break;
+    else
+      Fail(path, "line " + std::to_string(line_no) + ": unexpected header '" + Trim(line) + "'");
   }
   if (w <= 0 || h <= 0) Fail(path, "missing width/height header");
   mapping::OccupancyGrid grid(w, h, 1.0, 0.0, 0.0);

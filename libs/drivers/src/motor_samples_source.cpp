@@ -84,7 +84,8 @@ MotorSamplesSource::MotorSamplesSource(const std::string& path) {
     if (!ParseNumber(f[1], &duty) || std::abs(duty) > 1.0) {
       throw std::runtime_error(where + "duty '" + f[1] + "' is not a number in [-1, 1]");
     }
-    if (!ParseNumber(f[2], &speed)) throw std::runtime_error(where + "speed '" + f[2] + "' is not a finite number [rad/s]");
+    if (!ParseNumber(f[2], &speed))
+      throw std::runtime_error(where + "speed '" + f[2] + "' is not a finite number [rad/s]");
     Event ev;
     ev.t_us = ev.stamp_us = static_cast<int64_t>(events_.size()) * 1000;
     ev.channel = "motor_samples";

@@ -35,13 +35,15 @@ void ReadBotlabCases(const std::string& poses_path, std::vector<Event>* out) {
     if (line.empty()) continue;
     std::istringstream s(line);
     if (declared < 0) {
-      if (!(s >> declared) || declared < 0) Fail(poses_path, line_no, "expected the number of cases, got '" + line + "'");
+      if (!(s >> declared) || declared < 0)
+        Fail(poses_path, line_no, "expected the number of cases, got '" + line + "'");
       continue;
     }
     PlanRequest r;
     int should = 0;
     std::string extra;
-    if (!(s >> r.start.x >> r.start.y >> r.goal.x >> r.goal.y >> should) || (s >> extra) || (should != 0 && should != 1)) {
+    if (!(s >> r.start.x >> r.start.y >> r.goal.x >> r.goal.y >> should) || (s >> extra) ||
+        (should != 0 && should != 1)) {
       Fail(poses_path, line_no, "expected 'start_x start_y goal_x goal_y should_exist(0/1)', got '" + line + "'");
     }
     r.index = read++;
@@ -74,7 +76,8 @@ void ReadMovingAiScenarios(const std::string& scen_path, std::vector<Event>* out
     std::string map_name;
     int w, h, sx, sy, gx, gy;
     if (!(s >> r.bucket >> map_name >> w >> h >> sx >> sy >> gx >> gy >> r.optimal_length_m)) {
-      Fail(scen_path, line_no, "expected 'bucket map width height start_x start_y goal_x goal_y optimal', got '" + line + "'");
+      Fail(scen_path, line_no,
+           "expected 'bucket map width height start_x start_y goal_x goal_y optimal', got '" + line + "'");
     }
     if (!grid) {
       // Tried in each folder from the scenario's upwards: the path as written, the bare file name,
@@ -97,8 +100,9 @@ void ReadMovingAiScenarios(const std::string& scen_path, std::vector<Event>* out
       Fail(scen_path, line_no, "names map '" + map_name + "' but the file started with '" + map_rel + "'");
     }
     if (w != grid->width() || h != grid->height()) {
-      Fail(scen_path, line_no, "map size " + std::to_string(w) + "x" + std::to_string(h) + " differs from the map's " +
-                                   std::to_string(grid->width()) + "x" + std::to_string(grid->height()));
+      Fail(scen_path, line_no,
+           "map size " + std::to_string(w) + "x" + std::to_string(h) + " differs from the map's " +
+               std::to_string(grid->width()) + "x" + std::to_string(grid->height()));
     }
     for (auto [x, y] : {std::pair{sx, sy}, std::pair{gx, gy}}) {
       if (x < 0 || y < 0 || x >= w || y >= h) Fail(scen_path, line_no, "a position lies outside the map");

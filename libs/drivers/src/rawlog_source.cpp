@@ -113,20 +113,23 @@ RawlogSource::RawlogSource(const SourceOptions& options) {
         ++observations_;
         add_observation(rawlog.getAsObservation(i));
         break;
-      default:
-        break;
+      default: break;
     }
   }
   // An entry without timestamp takes the time of the entry before it (or after it, at the start).
   int64_t last_t = INT64_MIN;
   for (auto& ev : events_) {
-    if (ev.t_us == INT64_MIN) ev.t_us = ev.stamp_us = last_t;
-    else last_t = ev.t_us;
+    if (ev.t_us == INT64_MIN)
+      ev.t_us = ev.stamp_us = last_t;
+    else
+      last_t = ev.t_us;
   }
   last_t = INT64_MIN;
   for (auto it = events_.rbegin(); it != events_.rend(); ++it) {
-    if (it->t_us == INT64_MIN) it->t_us = it->stamp_us = last_t;
-    else last_t = it->t_us;
+    if (it->t_us == INT64_MIN)
+      it->t_us = it->stamp_us = last_t;
+    else
+      last_t = it->t_us;
   }
   if (last_t == INT64_MIN) {
     for (auto& ev : events_) ev.t_us = ev.stamp_us = 0;
@@ -143,9 +146,7 @@ std::optional<Event> RawlogSource::Next() {
   return std::move(events_[next_++]);
 }
 
-double RawlogSource::Progress() const {
-  return events_.empty() ? 1.0 : double(next_) / double(events_.size());
-}
+double RawlogSource::Progress() const { return events_.empty() ? 1.0 : double(next_) / double(events_.size()); }
 
 std::string RawlogSource::Format() const {
   return sensory_frames_ > 0 || actions_ > 0 ? "MRPT rawlog (actions / sensory frames)"

@@ -52,13 +52,15 @@ LiveSourceOptions ParseLiveSourceOptions(config::Section& s) {
   LiveSourceOptions o;
   o.channels = s.GetList("channels", o.channels, doc("channels to subscribe to"));
   o.duration_s = s.GetDouble("duration_s", o.duration_s, doc("the run ends after this long (0: never) [s]"), 0.0, 1e7);
-  o.end_after_silence_s = s.GetDouble("end_after_silence_s", o.end_after_silence_s,
-                                      doc("the run ends when no message arrived for this long (0: never) [s]"), 0.0, 1e7);
+  o.end_after_silence_s =
+      s.GetDouble("end_after_silence_s", o.end_after_silence_s,
+                  doc("the run ends when no message arrived for this long (0: never) [s]"), 0.0, 1e7);
   o.stale_sensor_s = s.GetDouble("stale_sensor_s", o.stale_sensor_s,
                                  doc("a watched channel silent this long stops the robot [s]"), 0.01, 1e4);
   o.watched = s.GetList("watched_channels", o.watched, doc("channels whose silence stops the robot"));
   o.command_channel = s.GetString("command_channel", o.command_channel, doc("velocity commands go out here"));
-  o.report_every_s = s.GetDouble("report_every_s", o.report_every_s, doc("log the loop rate and latency this often (0: never) [s]"), 0.0, 1e6);
+  o.report_every_s = s.GetDouble("report_every_s", o.report_every_s,
+                                 doc("log the loop rate and latency this often (0: never) [s]"), 0.0, 1e6);
   return o;
 }
 
@@ -95,7 +97,8 @@ bool IsCases(const std::string& path, const char* type) {
 // libs/drivers' own types; detect_order < 0 may name a folder, the others need a regular file.
 std::vector<SourceType> BuiltInTypes() {
   std::vector<SourceType> t;
-  t.push_back({"astar_cases", "the botlab A* test cases: a folder of *_poses.txt files beside their maps, or one of them",
+  t.push_back({"astar_cases",
+               "the botlab A* test cases: a folder of *_poses.txt files beside their maps, or one of them",
                [](const std::string& p) { return IsCases(p, "astar_cases"); }, -1, nullptr,
                [](const SourceOptions& o) { return std::make_unique<PlanningCasesSource>(o.path, "astar_cases"); }});
   t.push_back({"movingai", "a Moving AI .map.scen scenario file (its map beside it, or in ../../maps)",
@@ -114,8 +117,8 @@ std::vector<SourceType> BuiltInTypes() {
                [](const SourceOptions& o) { return std::make_unique<LcmLogSource>(o); }});
   t.push_back({"carmen", "a CARMEN log, plain or gzip", IsCarmenText, 20, nullptr,
                [](const SourceOptions& o) { return std::make_unique<CarmenSource>(o); }});
-  t.push_back({"lcm_live", "a robot (or the simulated one) on the LCM bus, in wall-clock time; path is the LCM url", nullptr, 0,
-               [](config::Section& s, SourceOptions* o) { o->live = ParseLiveSourceOptions(s); },
+  t.push_back({"lcm_live", "a robot (or the simulated one) on the LCM bus, in wall-clock time; path is the LCM url",
+               nullptr, 0, [](config::Section& s, SourceOptions* o) { o->live = ParseLiveSourceOptions(s); },
                [](const SourceOptions& o) { return std::make_unique<LcmLiveSource>(o); }});
   return t;
 }
@@ -153,19 +156,23 @@ SourceOptions ParseSourceOptions(config::Section& s) {
     o.path = s.GetString("url", kDefaultLcmUrl, "lcm_live: the LCM URL (ttl=0 keeps the traffic on this machine)");
   }
   if (!live) {
-    o.path = s.RequirePath("path", "the dataset to read (LCM log, MRPT rawlog, CARMEN log, map file, botlab A* poses file or folder, Moving AI .scen), or the simulator's world (.arena or a map)");
+    o.path = s.RequirePath("path",
+                           "the dataset to read (LCM log, MRPT rawlog, CARMEN log, map file, botlab A* poses file or "
+                           "folder, Moving AI .scen), or the simulator's world (.arena or a map)");
   }
   auto& r = o.roles;
   r.odometry = s.GetList("odometry_channels", r.odometry, "LCM channels whose poses are the robot's odometry");
   r.ground_truth = s.GetList("ground_truth_channels", r.ground_truth, "LCM channels carrying ground-truth poses");
-  r.rezero_ground_truth = s.GetList("rezero_ground_truth_channels", r.rezero_ground_truth,
-                                    "ground-truth channels re-zeroed to start at the origin (first pose subtracted, rotated by -theta0)");
+  r.rezero_ground_truth =
+      s.GetList("rezero_ground_truth_channels", r.rezero_ground_truth,
+                "ground-truth channels re-zeroed to start at the origin (first pose subtracted, rotated by -theta0)");
   r.reference_pose = s.GetList("reference_pose_channels", r.reference_pose,
                                "LCM channels with another estimator's poses (staff SLAM)");
   r.velocity_command = s.GetList("velocity_command_channels", r.velocity_command,
                                  "LCM channels whose twist2D_t messages are velocity commands");
-  o.carmen_max_range_m = s.GetDouble("carmen_max_range_m", o.carmen_max_range_m,
-                                     "CARMEN FLASER range limit when the log's PARAM lines do not give one [m]", 0.1, 1000.0);
+  o.carmen_max_range_m =
+      s.GetDouble("carmen_max_range_m", o.carmen_max_range_m,
+                  "CARMEN FLASER range limit when the log's PARAM lines do not give one [m]", 0.1, 1000.0);
   o.reorder_window_us = static_cast<int64_t>(
       1e6 * s.GetDouble("reorder_window_s", o.reorder_window_us * 1e-6,
                         "LCM log records are re-sorted by event time within this window [s]", 0.0, 10.0));
@@ -200,7 +207,8 @@ std::string DetectFormat(const std::string& path) {
     }
     if (t->detect(path)) return t->name;
   }
-  throw std::runtime_error(path + ": unrecognised format (not an LCM log, MRPT rawlog, CARMEN log, map or arena); set source.type");
+  throw std::runtime_error(
+      path + ": unrecognised format (not an LCM log, MRPT rawlog, CARMEN log, map or arena); set source.type");
 }
 
 std::unique_ptr<Source> OpenSource(const SourceOptions& options) {

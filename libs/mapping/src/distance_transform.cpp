@@ -56,7 +56,7 @@ std::vector<float> SquaredDistanceTransform(const std::vector<uint8_t>& obstacle
   constexpr int32_t kFar = 1 << 29;
   constexpr int kBlock = 256;
   const int blocks = (width + kBlock - 1) / kBlock;
-#pragma omp parallel for schedule(static) if (static_cast<size_t>(width) * height > 100000)
+#pragma omp parallel for schedule(static) if (static_cast <size_t>(width) * height > 100000)
   for (int b = 0; b < blocks; ++b) {
     const int x0 = b * kBlock, x1 = std::min(width, x0 + kBlock);
     for (int x = x0; x < x1; ++x) col[x] = obstacle[x] ? 0 : kFar;
@@ -74,7 +74,7 @@ std::vector<float> SquaredDistanceTransform(const std::vector<uint8_t>& obstacle
   }
   // Pass 2, along rows: the lower envelope of parabolas over the squared column distances. Rows
   // are independent; each thread keeps its own scratch. The result does not depend on the threads.
-#pragma omp parallel if (static_cast<size_t>(width) * height > 100000)
+#pragma omp parallel if (static_cast <size_t>(width) * height > 100000)
   {
     std::vector<float> f(width), z(width + 1);
     std::vector<int> v(width);

@@ -30,8 +30,10 @@ std::vector<double> Numbers(config::Section& s, const std::string& key, size_t c
 ScanOptions ParseScanOptions(config::Section& s, const ScanOptions& defaults) {
   ScanOptions o = defaults;
   o.min_range_m = s.GetDouble("min_range_m", o.min_range_m, "shorter returns are dropped", 0.0);
-  o.max_range_m = s.GetDouble("max_range_m", o.max_range_m, "returns at or beyond this are misses (0: the sensor's maximum)", 0.0);
-  o.no_return_clear_m = s.GetDouble("no_return_clear_m", o.no_return_clear_m, "a beam without return clears this far (0: not at all)", 0.0);
+  o.max_range_m =
+      s.GetDouble("max_range_m", o.max_range_m, "returns at or beyond this are misses (0: the sensor's maximum)", 0.0);
+  o.no_return_clear_m = s.GetDouble("no_return_clear_m", o.no_return_clear_m,
+                                    "a beam without return clears this far (0: not at all)", 0.0);
 
   return o;
 }
@@ -39,7 +41,8 @@ ScanOptions ParseScanOptions(config::Section& s, const ScanOptions& defaults) {
 MapperOptions ParseMapperOptions(config::Section& s, const MapperOptions& defaults) {
   MapperOptions mp = defaults;
   mp.hit_odds = static_cast<int>(s.GetInt("hit_odds", mp.hit_odds, "log-odds added to a ray's end cell", 0, 127));
-  mp.miss_odds = static_cast<int>(s.GetInt("miss_odds", mp.miss_odds, "log-odds removed from the cells a ray crosses", 0, 127));
+  mp.miss_odds =
+      static_cast<int>(s.GetInt("miss_odds", mp.miss_odds, "log-odds removed from the cells a ray crosses", 0, 127));
   mp.resolution_m = s.GetDouble("resolution_m", mp.resolution_m, "cell size", 0.001, 10.0);
   mp.width_m = s.GetDouble("width_m", mp.width_m, "initial map width", 0.01);
   mp.height_m = s.GetDouble("height_m", mp.height_m, "initial map height", 0.01);
@@ -69,42 +72,59 @@ SensorModelOptions ParseSensorModelOptions(config::Section& s, const SensorModel
                     "likelihood_field"
                 ? SensorModelKind::kLikelihoodField
                 : SensorModelKind::kSimplifiedField;
-  sm.ray_stride = static_cast<int>(s.GetInt("ray_stride", sm.ray_stride, "use every k-th ray in the sensor model", 1, 1000));
+  sm.ray_stride =
+      static_cast<int>(s.GetInt("ray_stride", sm.ray_stride, "use every k-th ray in the sensor model", 1, 1000));
   sm.sigma_m = s.GetDouble("sigma_m", sm.sigma_m, "likelihood field: end-point noise", 0.001);
   sm.max_distance_m = s.GetDouble("max_distance_m", sm.max_distance_m, "likelihood field: distances clamp here", 0.001);
-  sm.random_weight = s.GetDouble("random_weight", sm.random_weight, "likelihood field: uniform share for unexplained returns", 0.0);
-  sm.log_scale = s.GetDouble("log_scale", sm.log_scale, "multiplies a scan's log-likelihood (tempers beam correlation)", 1e-6);
+  sm.random_weight =
+      s.GetDouble("random_weight", sm.random_weight, "likelihood field: uniform share for unexplained returns", 0.0);
+  sm.log_scale =
+      s.GetDouble("log_scale", sm.log_scale, "multiplies a scan's log-likelihood (tempers beam correlation)", 1e-6);
   sm.odds_scale = s.GetDouble("odds_scale", sm.odds_scale, "simplified field: log-likelihood per log-odds unit", 0.0);
-  sm.neighbour_weight = s.GetDouble("neighbour_weight", sm.neighbour_weight, "simplified field: weight of the cell before/after", 0.0, 1.0);
-  sm.inlier_distance_m = s.GetDouble("inlier_distance_m", sm.inlier_distance_m, "a ray fits the map when it ends this close to an obstacle", 0.0);
+  sm.neighbour_weight = s.GetDouble("neighbour_weight", sm.neighbour_weight,
+                                    "simplified field: weight of the cell before/after", 0.0, 1.0);
+  sm.inlier_distance_m = s.GetDouble("inlier_distance_m", sm.inlier_distance_m,
+                                     "a ray fits the map when it ends this close to an obstacle", 0.0);
 
   return sm;
 }
 
-ParticleFilterOptions ParseParticleFilterOptions(config::Section& s, SlamMode mode, const ParticleFilterOptions& defaults) {
+ParticleFilterOptions ParseParticleFilterOptions(config::Section& s, SlamMode mode,
+                                                 const ParticleFilterOptions& defaults) {
   ParticleFilterOptions f = defaults;
   f.particles = static_cast<int>(s.GetInt("particles", f.particles, "particles", 1, 10'000'000));
-  f.top_fraction = s.GetDouble("top_fraction", f.top_fraction, "the estimate averages this share of the best particles", 1e-6, 1.0);
+  f.top_fraction =
+      s.GetDouble("top_fraction", f.top_fraction, "the estimate averages this share of the best particles", 1e-6, 1.0);
   f.threads = static_cast<int>(s.GetInt("threads", f.threads, "threads for the particles (0: all cores)", 0, 256));
-  f.global_particles = static_cast<int>(s.GetInt("global_particles", f.global_particles, "particles for global localization", 1, 10'000'000));
-  f.converged_spread_m = s.GetDouble("converged_spread_m", f.converged_spread_m, "a global search has converged below this spread", 0.0);
+  f.global_particles = static_cast<int>(
+      s.GetInt("global_particles", f.global_particles, "particles for global localization", 1, 10'000'000));
+  f.converged_spread_m =
+      s.GetDouble("converged_spread_m", f.converged_spread_m, "a global search has converged below this spread", 0.0);
   const std::vector<double> box = Numbers(s, "global_region", 4, "min_x, max_x, min_y, max_y",
-      "global localization starts from the free cells inside this box (min_x, max_x, min_y, max_y [m]); empty: the whole map");
+                                          "global localization starts from the free cells inside this box (min_x, "
+                                          "max_x, min_y, max_y [m]); empty: the whole map");
   if (!box.empty()) {
     if (!(box[0] < box[1] && box[2] < box[3])) s.Fail("global_region", "needs min_x < max_x and min_y < max_y");
     f.global_region = SearchBox{box[0], box[1], box[2], box[3]};
   }
-  f.global_min_ess_fraction = s.GetDouble("global_min_ess_fraction", f.global_min_ess_fraction,
-                                          "a global search tempers the scan likelihood to keep this share of particles effective (0: off)", 0.0, 1.0);
-  f.converged_inlier_fraction = s.GetDouble("converged_inlier_fraction", f.converged_inlier_fraction,
-                                            "a settled global search is accepted when this share of the scan fits the map, else it starts again", 0.0, 1.0);
-  f.augmented = s.GetBool("augmented", mode == SlamMode::kLocalization, "augmented MCL: inject random particles when the fit drops");
+  f.global_min_ess_fraction = s.GetDouble(
+      "global_min_ess_fraction", f.global_min_ess_fraction,
+      "a global search tempers the scan likelihood to keep this share of particles effective (0: off)", 0.0, 1.0);
+  f.converged_inlier_fraction = s.GetDouble(
+      "converged_inlier_fraction", f.converged_inlier_fraction,
+      "a settled global search is accepted when this share of the scan fits the map, else it starts again", 0.0, 1.0);
+  f.augmented = s.GetBool("augmented", mode == SlamMode::kLocalization,
+                          "augmented MCL: inject random particles when the fit drops");
   f.alpha_slow = s.GetDouble("alpha_slow", f.alpha_slow, "augmented MCL: long-term fit average rate", 0.0, 1.0);
   f.alpha_fast = s.GetDouble("alpha_fast", f.alpha_fast, "augmented MCL: short-term fit average rate", 0.0, 1.0);
-  f.max_injection = s.GetDouble("max_injection", f.max_injection, "augmented MCL: largest share replaced per update", 0.0, 1.0);
-  f.lost_inlier_fraction = s.GetDouble("lost_inlier_fraction", f.lost_inlier_fraction, "lost when the estimate's inlier share stays below this", 0.0, 1.0);
-  f.lost_fit_ratio = s.GetDouble("lost_fit_ratio", f.lost_fit_ratio, "... or the short-term scan fit below this share of the long-term one", 0.0, 1.0);
-  f.lost_scans = static_cast<int>(s.GetInt("lost_scans", f.lost_scans, "... for this many updates in a row", 1, 1000000));
+  f.max_injection =
+      s.GetDouble("max_injection", f.max_injection, "augmented MCL: largest share replaced per update", 0.0, 1.0);
+  f.lost_inlier_fraction = s.GetDouble("lost_inlier_fraction", f.lost_inlier_fraction,
+                                       "lost when the estimate's inlier share stays below this", 0.0, 1.0);
+  f.lost_fit_ratio = s.GetDouble("lost_fit_ratio", f.lost_fit_ratio,
+                                 "... or the short-term scan fit below this share of the long-term one", 0.0, 1.0);
+  f.lost_scans =
+      static_cast<int>(s.GetInt("lost_scans", f.lost_scans, "... for this many updates in a row", 1, 1000000));
   f.relocalize_when_lost = s.GetBool("relocalize_when_lost", mode == SlamMode::kLocalization,
                                      "localization: spread the particles over the map again when lost");
   return f;
@@ -112,13 +132,14 @@ ParticleFilterOptions ParseParticleFilterOptions(config::Section& s, SlamMode mo
 
 SlamOptions ParseSlamOptions(config::Section& s) {
   SlamOptions m;
-  m.mode = s.GetEnum("mode", SlamMode::kFullSlam,
-                     {{"full_slam", SlamMode::kFullSlam},
-                      {"localization", SlamMode::kLocalization},
-                      {"mapping_only", SlamMode::kMappingOnly},
-                      {"action_only", SlamMode::kActionOnly}},
-                     "what runs: full SLAM, localization on a known map, mapping from known poses, or particles driven by "
-                     "odometry alone");
+  m.mode =
+      s.GetEnum("mode", SlamMode::kFullSlam,
+                {{"full_slam", SlamMode::kFullSlam},
+                 {"localization", SlamMode::kLocalization},
+                 {"mapping_only", SlamMode::kMappingOnly},
+                 {"action_only", SlamMode::kActionOnly}},
+                "what runs: full SLAM, localization on a known map, mapping from known poses, or particles driven by "
+                "odometry alone");
   m.mapper = ParseMapperOptions(s);
   m.action = ParseActionModelOptions(s);
   m.sensor = ParseSensorModelOptions(s);

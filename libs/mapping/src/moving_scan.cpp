@@ -6,8 +6,7 @@ namespace mbot::mapping {
 
 std::vector<ScanRay> DeskewScan(const std::vector<float>& ranges, const std::vector<float>& angles,
                                 const std::vector<float>& fractions, const motion::Pose2D& start_in_end,
-                                const motion::Pose2D& sensor, double sensor_max_range_m,
-                                const ScanOptions& options) {
+                                const motion::Pose2D& sensor, double sensor_max_range_m, const ScanOptions& options) {
   double max_range = options.max_range_m > 0 ? options.max_range_m : sensor_max_range_m;
   if (options.max_range_m > 0 && sensor_max_range_m > 0) max_range = std::min(max_range, sensor_max_range_m);
   std::vector<ScanRay> rays;
@@ -60,7 +59,8 @@ BeamTimes TimeBeams(BeamTiming timing, const std::vector<float>& angles, const s
                     int64_t period) {
   BeamTimes out;
   const size_t n = angles.size();
-  const bool beams_usable = beam_times.size() == n && n > 1 && period > 0 && beam_times.back() - beam_times.front() > period / 2;
+  const bool beams_usable =
+      beam_times.size() == n && n > 1 && period > 0 && beam_times.back() - beam_times.front() > period / 2;
   if (timing == BeamTiming::kBeams || (timing == BeamTiming::kAuto && beams_usable)) {
     if (!beams_usable) {
       out.beam_times_unusable = true;

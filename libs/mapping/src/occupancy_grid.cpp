@@ -7,12 +7,12 @@
 
 namespace mbot::mapping {
 
-OccupancyGrid::OccupancyGrid(int width, int height, double resolution_m, double origin_x_m,
-                             double origin_y_m, int8_t fill)
+OccupancyGrid::OccupancyGrid(int width, int height, double resolution_m, double origin_x_m, double origin_y_m,
+                             int8_t fill)
     : width_(width), height_(height), resolution_(resolution_m), origin_x_(origin_x_m), origin_y_(origin_y_m) {
   if (width < 0 || height < 0 || !(resolution_m > 0.0)) {
-    throw std::invalid_argument("OccupancyGrid: bad size " + std::to_string(width) + "x" +
-                                std::to_string(height) + " or resolution " + std::to_string(resolution_m));
+    throw std::invalid_argument("OccupancyGrid: bad size " + std::to_string(width) + "x" + std::to_string(height) +
+                                " or resolution " + std::to_string(resolution_m));
   }
   cells_.assign(static_cast<size_t>(width) * height, fill);
 }
@@ -30,16 +30,19 @@ void OccupancyGrid::CellToWorld(int cx, int cy, double* x, double* y) const {
 OccupancyGrid::Stats OccupancyGrid::CountCells() const {
   Stats s;
   for (int8_t c : cells_) {
-    if (c > 0) ++s.occupied;
-    else if (c < 0) ++s.free;
-    else ++s.unknown;
+    if (c > 0)
+      ++s.occupied;
+    else if (c < 0)
+      ++s.free;
+    else
+      ++s.unknown;
   }
   return s;
 }
 
 bool OccupancyGrid::operator==(const OccupancyGrid& o) const {
-  return width_ == o.width_ && height_ == o.height_ && resolution_ == o.resolution_ &&
-         origin_x_ == o.origin_x_ && origin_y_ == o.origin_y_ && cells_ == o.cells_;
+  return width_ == o.width_ && height_ == o.height_ && resolution_ == o.resolution_ && origin_x_ == o.origin_x_ &&
+         origin_y_ == o.origin_y_ && cells_ == o.cells_;
 }
 
 OccupancyGrid CropToKnown(const OccupancyGrid& m, double margin_m) {

@@ -15,8 +15,7 @@ namespace {
 constexpr uint64_t kTagInit = 1, kTagResample = 2, kTagInject = 3, kTagMove = 4, kTagGlobal = 5;
 }  // namespace
 
-ParticleFilter::ParticleFilter(const ParticleFilterOptions& options, uint64_t seed)
-    : options_(options), seed_(seed) {
+ParticleFilter::ParticleFilter(const ParticleFilterOptions& options, uint64_t seed) : options_(options), seed_(seed) {
   if (options.particles < 1) throw std::invalid_argument("particle filter: particles must be >= 1");
 }
 
@@ -64,7 +63,8 @@ motion::Pose2D ParticleFilter::RandomFreePose(const std::vector<int32_t>& cells,
   const int cell = cells[k];
   const int cx = cell % free_width_, cy = cell / free_width_;
   return {free_origin_x_ + (cx + rng.Uniform()) * free_resolution_,
-          free_origin_y_ + (cy + rng.Uniform()) * free_resolution_, motion::WrapAngle((2.0 * rng.Uniform() - 1.0) * M_PI)};
+          free_origin_y_ + (cy + rng.Uniform()) * free_resolution_,
+          motion::WrapAngle((2.0 * rng.Uniform() - 1.0) * M_PI)};
 }
 
 void ParticleFilter::InitializeGlobal() {
@@ -202,7 +202,8 @@ FilterStatus ParticleFilter::Update(const ActionModel& action, const OdometrySte
   status_.converged = !global_;
 
   status_.fit_ratio = w_slow_ > 0 ? w_fast_ / w_slow_ : 1.0;
-  const bool bad = status_.inlier_fraction < options_.lost_inlier_fraction || status_.fit_ratio < options_.lost_fit_ratio;
+  const bool bad =
+      status_.inlier_fraction < options_.lost_inlier_fraction || status_.fit_ratio < options_.lost_fit_ratio;
   bad_scans_ = bad ? bad_scans_ + 1 : 0;
   status_.lost = bad_scans_ >= options_.lost_scans;
   if ((respread || (status_.lost && options_.relocalize_when_lost && !global_)) && !free_cells_.empty()) {
@@ -239,7 +240,8 @@ void ParticleFilter::Estimate() {
     my += p.weight * p.pose.y;
   }
   double var = 0;
-  for (const Particle& p : particles_) var += p.weight * ((p.pose.x - mx) * (p.pose.x - mx) + (p.pose.y - my) * (p.pose.y - my));
+  for (const Particle& p : particles_)
+    var += p.weight * ((p.pose.x - mx) * (p.pose.x - mx) + (p.pose.y - my) * (p.pose.y - my));
   status_.spread_m = std::sqrt(var);
 }
 

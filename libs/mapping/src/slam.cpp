@@ -48,8 +48,10 @@ std::string SlamEventTracker::Add(double t, int scan, bool updated, const Filter
   const bool open = !lost_.empty() && lost_.back().recovered_at_scan < 0;
   if (status.lost && !open) {
     lost_.push_back({t, scan, -1, -1});
-    said += (said.empty() ? "" : "; ") + std::string("lost at ") + num(t, 4) + " s (inlier share " + num(status.inlier_fraction, 3) + ")";
-  } else if (open && updated && status.converged && !status.lost && status.inlier_fraction >= recovered_inlier_fraction_) {
+    said += (said.empty() ? "" : "; ") + std::string("lost at ") + num(t, 4) + " s (inlier share " +
+            num(status.inlier_fraction, 3) + ")";
+  } else if (open && updated && status.converged && !status.lost &&
+             status.inlier_fraction >= recovered_inlier_fraction_) {
     lost_.back().recovered_at_s = t;
     lost_.back().recovered_at_scan = scan;
     said += (said.empty() ? "" : "; ") + std::string("recovered at ") + num(t, 4) + " s";

@@ -27,33 +27,40 @@ MissionOptions ParseMissionOptions(config::Section& s) {
                      "deliveries in the known map, or drive the paths a GUI sends");
   const bool describing = s.describing();
   if (o.task == TaskKind::kWaypoints || describing) {
-    o.waypoints = ToPoses(s.GetPoses("waypoints", {}, "waypoints: the circuit in the map frame (SLAM starts at the origin)"));
+    o.waypoints =
+        ToPoses(s.GetPoses("waypoints", {}, "waypoints: the circuit in the map frame (SLAM starts at the origin)"));
     if (o.waypoints.empty() && !describing) s.Fail("waypoints", "task = waypoints needs at least one waypoint");
   }
   if (o.task == TaskKind::kWarehouse || describing) {
-    o.targets = ToPoses(s.GetPoses("targets", {}, "warehouse: the day's targets (crates to lift) in the known map's frame"));
+    o.targets =
+        ToPoses(s.GetPoses("targets", {}, "warehouse: the day's targets (crates to lift) in the known map's frame"));
     o.dropoffs = ToPoses(s.GetPoses("dropoffs", {}, "warehouse: the day's drop-offs in the known map's frame"));
     const size_t needed = static_cast<size_t>(warehouse::TotalDeliveries());
     if (!describing && o.targets.size() < needed) {
-      s.Fail("targets", "the Warehouse needs " + std::to_string(needed) + " targets, " + std::to_string(o.targets.size()) + " given");
+      s.Fail("targets", "the Warehouse needs " + std::to_string(needed) + " targets, " +
+                            std::to_string(o.targets.size()) + " given");
     }
     if (!describing && o.dropoffs.empty()) s.Fail("dropoffs", "the Warehouse needs at least one drop-off");
-    o.deliveries = static_cast<int>(s.GetInt("deliveries", o.deliveries,
-                                             "warehouse: make only the first this many deliveries of the seed's order, for a "
-                                             "short run (0: all the rules ask)",
-                                             0, warehouse::TotalDeliveries()));
+    o.deliveries =
+        static_cast<int>(s.GetInt("deliveries", o.deliveries,
+                                  "warehouse: make only the first this many deliveries of the seed's order, for a "
+                                  "short run (0: all the rules ask)",
+                                  0, warehouse::TotalDeliveries()));
   }
   o.controller = motion::ParseMotionControllerOptions(s);
   o.exploration = planning::ParseExplorationOptions(s);
-  o.explore_period_s = s.GetDouble("explore_period_s", o.explore_period_s, "explorer updates at most this often [s]", 0.0, 60.0);
+  o.explore_period_s =
+      s.GetDouble("explore_period_s", o.explore_period_s, "explorer updates at most this often [s]", 0.0, 60.0);
   o.start_delay_s =
       s.GetDouble("start_delay_s", o.start_delay_s, "stand still this long after the first SLAM pose [s]", 0.0, 60.0);
   o.max_pose_age_s =
       s.GetDouble("max_pose_age_s", o.max_pose_age_s, "stop when the SLAM pose is older than this [s]", 0.01, 60.0);
-  o.control_lag_s = s.GetDouble("control_lag_s", o.control_lag_s,
-                                "the controller sees the pose predicted this far ahead (the wheels' response lag) [s]", 0.0, 2.0);
-  o.max_corrections = static_cast<int>(s.GetInt(
-      "max_corrections", o.max_corrections, "times the final pose is driven to again when the robot stopped outside the tolerances", 0, 100));
+  o.control_lag_s =
+      s.GetDouble("control_lag_s", o.control_lag_s,
+                  "the controller sees the pose predicted this far ahead (the wheels' response lag) [s]", 0.0, 2.0);
+  o.max_corrections = static_cast<int>(
+      s.GetInt("max_corrections", o.max_corrections,
+               "times the final pose is driven to again when the robot stopped outside the tolerances", 0, 100));
   o.stuck_s = s.GetDouble("stuck_s", o.stuck_s, "commanded to move but stalled this long: back off [s]", 0.1, 60.0);
   o.max_stalls = static_cast<int>(
       s.GetInt("max_stalls", o.max_stalls, "stalls on the way to one goal before the mission fails", 0, 100000));

@@ -3,8 +3,8 @@
 namespace mbot::mission {
 
 namespace {
-constexpr MissionState kAll[] = {MissionState::kInitializing, MissionState::kLocalizing, MissionState::kWaiting,
-                                 MissionState::kDriving,      MissionState::kExploring,  MissionState::kReturningHome,
+constexpr MissionState kAll[] = {MissionState::kInitializing, MissionState::kLocalizing,  MissionState::kWaiting,
+                                 MissionState::kDriving,      MissionState::kExploring,   MissionState::kReturningHome,
                                  MissionState::kLifting,      MissionState::kSettingDown, MissionState::kArrived,
                                  MissionState::kCompleted,    MissionState::kFailed};
 }

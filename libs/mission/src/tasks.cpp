@@ -53,7 +53,8 @@ class ExploreTask : public Task {
       // Home is a pose: the way back ends in the heading the robot started with.
       std::vector<Pose2D> path = u.path;
       if (u.state == planning::ExplorationState::kCompleted) path = {explorer_.home()};
-      if (u.state != planning::ExplorationState::kExploring && !path.empty()) path.back().theta = explorer_.home().theta;
+      if (u.state != planning::ExplorationState::kExploring && !path.empty())
+        path.back().theta = explorer_.home().theta;
       m.SetPath(path);
     }
     if (u.state == planning::ExplorationState::kCompleted) {
@@ -103,8 +104,8 @@ class WarehouseTask : public Task {
   bool Step(Mission& m, const Pose2D& pose) override {
     const std::optional<mapping::SlamState> slam = m.slam_state();
     if (slam != mapping::SlamState::kLocalized) {
-      m.SetState(MissionState::kLocalizing,
-                 "waiting for SLAM to localize (it says " + std::string(slam ? mapping::ToString(*slam) : "nothing yet") + ")");
+      m.SetState(MissionState::kLocalizing, "waiting for SLAM to localize (it says " +
+                                                std::string(slam ? mapping::ToString(*slam) : "nothing yet") + ")");
       if (m.final_leg()) need_plan_ = true;  // the path was planned from a pose no longer trusted
       m.Hold();
       return false;
@@ -151,7 +152,8 @@ class WarehouseTask : public Task {
     m.EndFinalLeg();
     const warehouse::Stop& stop = stops_[stop_index_];
     dwell_until_us_ = m.now_us() + static_cast<int64_t>(dwell_s_ * 1e6);
-    m.SetState(stop.pickup ? MissionState::kLifting : MissionState::kSettingDown, "at " + stop.Name() + " (" + how + ")");
+    m.SetState(stop.pickup ? MissionState::kLifting : MissionState::kSettingDown,
+               "at " + stop.Name() + " (" + how + ")");
   }
   void Stalled(Mission& m) override {
     if (m.final_leg()) need_plan_ = true;

@@ -26,8 +26,9 @@ std::vector<Stop> Stops(const std::vector<motion::Pose2D>& targets, const std::v
                         uint64_t seed) {
   const int n = TotalDeliveries();
   if (static_cast<int>(targets.size()) < n || dropoffs.empty()) {
-    throw std::invalid_argument("the Warehouse needs " + std::to_string(n) + " targets and at least one drop-off (has " +
-                                std::to_string(targets.size()) + " and " + std::to_string(dropoffs.size()) + ")");
+    throw std::invalid_argument("the Warehouse needs " + std::to_string(n) +
+                                " targets and at least one drop-off (has " + std::to_string(targets.size()) + " and " +
+                                std::to_string(dropoffs.size()) + ")");
   }
   std::vector<int> order(targets.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);

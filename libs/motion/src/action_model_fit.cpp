@@ -51,9 +51,8 @@ ActionModelFit FitActionModel(const std::vector<Pose2D>& odometry, const std::ve
                               const ActionModelFitOptions& options) {
   ActionModelFit fit;
   const int w = options.window_steps;
-  if (w < 1 || !(options.min_sigma_rot_rad > 0) || !(options.min_sigma_trans_m > 0) ||
-      !(options.initial_k1 > 0) || !(options.initial_k2 > 0) || !std::isfinite(options.initial_k1) ||
-      !std::isfinite(options.initial_k2)) {
+  if (w < 1 || !(options.min_sigma_rot_rad > 0) || !(options.min_sigma_trans_m > 0) || !(options.initial_k1 > 0) ||
+      !(options.initial_k2 > 0) || !std::isfinite(options.initial_k1) || !std::isfinite(options.initial_k2)) {
     fit.message = "invalid options: need window_steps >= 1, noise floors > 0 and finite initial k > 0";
     return fit;
   }
@@ -63,8 +62,7 @@ ActionModelFit FitActionModel(const std::vector<Pose2D>& odometry, const std::ve
     return fit;
   }
   if (odometry.size() < static_cast<size_t>(w) + 1) {
-    fit.message = "too short: " + std::to_string(odometry.size()) + " samples, a window needs " +
-                  std::to_string(w + 1);
+    fit.message = "too short: " + std::to_string(odometry.size()) + " samples, a window needs " + std::to_string(w + 1);
     return fit;
   }
 
@@ -147,7 +145,8 @@ ActionModelFit FitActionModel(const std::vector<Pose2D>& odometry, const std::ve
   }
   constexpr double kAtZero = 1e-9;  // far below any plausible k; the fit ran towards k = 0
   if (fit.k1 < kAtZero) AddNote(&fit.message, "k1 ~ 0: rotation errors lie within the noise floor");
-  if (translating > 0 && fit.k2 < kAtZero) AddNote(&fit.message, "k2 ~ 0: translation errors lie within the noise floor");
+  if (translating > 0 && fit.k2 < kAtZero)
+    AddNote(&fit.message, "k2 ~ 0: translation errors lie within the noise floor");
   return fit;
 }
 

@@ -38,8 +38,7 @@ const Pose2D& Gyrodometry::AddEncoders(int64_t t_us, int64_t left_ticks, int64_t
   }
   moved_ = moved_ || step.distance_m != 0.0 || step.turn_rad != 0.0;
   switch (options_.heading) {
-    case HeadingSource::kEncoders:
-      break;
+    case HeadingSource::kEncoders: break;
     case HeadingSource::kGyrodometry:
       if (have_rate_ && dt > 0 && std::abs(gyro_turn_ - step.turn_rad) > options_.threshold_rad_s * dt) {
         step.turn_rad = gyro_turn_;

@@ -12,9 +12,7 @@ double Clamp(double x, double limit) { return std::clamp(x, -limit, limit); }
 double Dist(const Pose2D& a, const Pose2D& b) { return std::hypot(b.x - a.x, b.y - a.y); }
 
 // Direction of the point (x, y) seen from `p`, relative to its heading.
-double Bearing(const Pose2D& p, double x, double y) {
-  return WrapAngle(std::atan2(y - p.y, x - p.x) - p.theta);
-}
+double Bearing(const Pose2D& p, double x, double y) { return WrapAngle(std::atan2(y - p.y, x - p.x) - p.theta); }
 
 }  // namespace
 
@@ -183,8 +181,8 @@ double MotionController::Speed(double stop_distance_m) const {
 double MotionController::TurnRate(double heading_error_rad) const {
   const double e = std::abs(heading_error_rad);
   // The square-root term is the rate from which max_angular_accel still stops within e.
-  const double w = std::min({options_.k_bearing * e, options_.max_turn_rate_rad_s,
-                             std::sqrt(2.0 * options_.max_angular_accel_rad_s2 * e)});
+  const double w = std::min(
+      {options_.k_bearing * e, options_.max_turn_rate_rad_s, std::sqrt(2.0 * options_.max_angular_accel_rad_s2 * e)});
   return std::copysign(w, heading_error_rad);
 }
 

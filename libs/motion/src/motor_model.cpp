@@ -118,7 +118,8 @@ MotorFitReport FitMotorCalibration(const std::vector<MotorSample>& left, const s
                                    const MotorFitOptions& options) {
   MotorFitReport r;
   r.left = FitWheel(left, options.left_motor_polarity, options.left_encoder_polarity, options, &r.calibration.left);
-  r.right = FitWheel(right, options.right_motor_polarity, options.right_encoder_polarity, options, &r.calibration.right);
+  r.right =
+      FitWheel(right, options.right_motor_polarity, options.right_encoder_polarity, options, &r.calibration.right);
   Check("left", r.left, options, &r.problems);
   Check("right", r.right, options, &r.problems);
   r.acceptable = r.problems.empty();

@@ -22,8 +22,7 @@ Pose2D Pose2D::Inverse() const {
 }
 
 Pose2D Interpolate(const Pose2D& a, const Pose2D& b, double s) {
-  return {a.x + s * (b.x - a.x), a.y + s * (b.y - a.y),
-          WrapAngle(a.theta + s * WrapAngle(b.theta - a.theta))};
+  return {a.x + s * (b.x - a.x), a.y + s * (b.y - a.y), WrapAngle(a.theta + s * WrapAngle(b.theta - a.theta))};
 }
 
 OdometryStep OdometryStepBetween(const Pose2D& from, const Pose2D& to) {
@@ -41,8 +40,8 @@ OdometryStep OdometryStepBetween(const Pose2D& from, const Pose2D& to) {
 
 bool InterpolateAt(const std::vector<TimedPose>& series, int64_t t_us, int64_t max_gap_us, Pose2D* out) {
   if (series.empty()) return false;
-  auto it = std::lower_bound(series.begin(), series.end(), t_us,
-                             [](const TimedPose& p, int64_t t) { return p.t_us < t; });
+  auto it =
+      std::lower_bound(series.begin(), series.end(), t_us, [](const TimedPose& p, int64_t t) { return p.t_us < t; });
   if (it == series.end()) {
     if (t_us - series.back().t_us > max_gap_us) return false;
     *out = series.back().pose;

@@ -24,7 +24,8 @@ Pose2D BestFitSE2(const std::vector<Pose2D>& est, const std::vector<Pose2D>& tru
     sxy += ax * by - ay * bx;
   }
   double spread = 0;  // RMS distance of the true positions from their centroid
-  for (size_t i = 0; i < n; ++i) spread += (truth[i].x - tx) * (truth[i].x - tx) + (truth[i].y - ty) * (truth[i].y - ty);
+  for (size_t i = 0; i < n; ++i)
+    spread += (truth[i].x - tx) * (truth[i].x - tx) + (truth[i].y - ty) * (truth[i].y - ty);
   spread = std::sqrt(spread / n);
   double theta = std::atan2(sxy, sxx);
   if (n == 1 || spread < 0.05) {  // positions (a robot standing still) fix no rotation: use the mean heading offset
@@ -57,11 +58,14 @@ ErrorStats Stats(const std::vector<double>& e) {
 }  // namespace
 
 AteResult ComputeAte(const std::vector<Pose2D>& est, const std::vector<Pose2D>& truth, AteAlignment alignment) {
-  if (est.empty() || est.size() != truth.size()) throw std::invalid_argument("ComputeAte: needs paired, non-empty series");
+  if (est.empty() || est.size() != truth.size())
+    throw std::invalid_argument("ComputeAte: needs paired, non-empty series");
   AteResult r;
   r.samples = static_cast<int>(est.size());
-  if (alignment == AteAlignment::kBestFitSE2) r.alignment = BestFitSE2(est, truth);
-  else if (alignment == AteAlignment::kFirstPose) r.alignment = truth.front().Compose(est.front().Inverse());
+  if (alignment == AteAlignment::kBestFitSE2)
+    r.alignment = BestFitSE2(est, truth);
+  else if (alignment == AteAlignment::kFirstPose)
+    r.alignment = truth.front().Compose(est.front().Inverse());
   std::vector<double> ex, ey, et, exy;
   for (size_t i = 0; i < est.size(); ++i) {
     const Pose2D a = r.alignment.Compose(est[i]);

@@ -21,9 +21,7 @@ struct HeapEntry {
 // Smallest f first; among equal f the deeper node (larger g) first, which keeps A* from fanning
 // out over the many equal-cost paths of an open grid.
 struct HeapOrder {
-  bool operator()(const HeapEntry& a, const HeapEntry& b) const {
-    return a.f > b.f || (a.f == b.f && a.g < b.g);
-  }
+  bool operator()(const HeapEntry& a, const HeapEntry& b) const { return a.f > b.f || (a.f == b.f && a.g < b.g); }
 };
 
 }  // namespace
@@ -46,8 +44,8 @@ const char* ToString(PlanStatus s) {
 struct AStarPlanner::Impl {
   int width = 0, height = 0, stride = 0, rows = 0;
   double resolution = 0.05, origin_x = 0.0, origin_y = 0.0;
-  std::vector<float> dist;      // padded; -1 on the border
-  std::vector<float> penalty;   // padded; extra cost per cell of travel into the cell
+  std::vector<float> dist;     // padded; -1 on the border
+  std::vector<float> penalty;  // padded; extra cost per cell of travel into the cell
   bool use_penalty = false;
   int offsets[8];
   double step_len[8];
@@ -269,7 +267,8 @@ void AStarPlanner::SetMap(const ObstacleDistanceGrid& d) {
     for (size_t i = 0; i < n; ++i) {
       const double dd = m.dist[i];
       if (dd >= 0.0 && dd < range) {
-        m.penalty[i] = static_cast<float>(options_.penalty_weight * std::pow((range - dd) / range, options_.penalty_exponent));
+        m.penalty[i] =
+            static_cast<float>(options_.penalty_weight * std::pow((range - dd) / range, options_.penalty_exponent));
       }
     }
   }
@@ -391,18 +390,17 @@ PlanResult AStarPlanner::PlanAtClearance(const motion::Pose2D& start, const moti
     p.x = m.origin_x + (cx + 0.5) * m.resolution;
     p.y = m.origin_y + (cy + 0.5) * m.resolution;
     path.push_back(p);
-    if (i > 0) length_cells += (std::abs(cells[i] - cells[i - 1]) == 1 || std::abs(cells[i] - cells[i - 1]) == m.stride) ? 1.0 : kSqrt2;
+    if (i > 0)
+      length_cells +=
+          (std::abs(cells[i] - cells[i - 1]) == 1 || std::abs(cells[i] - cells[i - 1]) == m.stride) ? 1.0 : kSqrt2;
   }
   r.length_m = length_cells * m.resolution;
   path.front() = start;
   path.back() = goal;
   path = HeadingsAlong(std::move(path));
   switch (options_.prune) {
-    case PruneMode::kNone:
-      break;
-    case PruneMode::kCollinear:
-      path = PruneCollinear(path);
-      break;
+    case PruneMode::kNone: break;
+    case PruneMode::kCollinear: path = PruneCollinear(path); break;
     case PruneMode::kLineOfSight: {
       path = PruneCollinear(path);
       std::vector<motion::Pose2D> out = {path.front()};

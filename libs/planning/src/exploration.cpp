@@ -34,7 +34,8 @@ Explorer::Explorer(const ExplorationOptions& options) : options_(options), plann
 
 bool Explorer::IsBlacklisted(const Frontier& f, double t_s) const {
   for (const Blacklisted& b : blacklist_) {
-    if (t_s < b.until_s && std::hypot(f.centroid_x - b.x, f.centroid_y - b.y) <= options_.blacklist_radius_m) return true;
+    if (t_s < b.until_s && std::hypot(f.centroid_x - b.x, f.centroid_y - b.y) <= options_.blacklist_radius_m)
+      return true;
   }
   return false;
 }
@@ -94,7 +95,8 @@ bool Explorer::SelectFrontier(const mapping::OccupancyGrid& map, const motion::P
     u->path = path_;
     u->reason += (u->reason.empty() ? "" : "; ") +
                  Format("exploring a frontier of %.0f cells at (%.2f, %.2f)", f.size(), f.centroid_x, f.centroid_y) +
-                 Format(" from (%.2f, %.2f)", g.target.x, g.target.y) + Format(" with clearance %.2f m", plan.clearance_m, 0.0);
+                 Format(" from (%.2f, %.2f)", g.target.x, g.target.y) +
+                 Format(" with clearance %.2f m", plan.clearance_m, 0.0);
     return true;
   }
   return false;
@@ -128,7 +130,8 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
       // wait for the next map rather than give up.
       path_.clear();
       u.new_path = true;
-      u.reason += (u.reason.empty() ? "" : "; ") + std::string("robot too close to obstacles or unknown space to plan home, waiting");
+      u.reason += (u.reason.empty() ? "" : "; ") +
+                  std::string("robot too close to obstacles or unknown space to plan home, waiting");
       return;
     }
     if (plan.status != PlanStatus::kFound) {
@@ -163,7 +166,8 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
       if (!reached) reached_at_s_ = -1;  // pushed or drifted off: the wait starts again on return
       // What the robot saw on the way changed the frontier (part of it was resolved, its centroid
       // moved): the target chosen for the old one may not show the rest, so choose again.
-      const bool changed = match && (match_d > kFrontierMovedM || std::abs(match->size() - target_size_) > 0.25 * target_size_);
+      const bool changed =
+          match && (match_d > kFrontierMovedM || std::abs(match->size() - target_size_) > 0.25 * target_size_);
       if (!match) {
         need = true;
         why = "target frontier explored";
@@ -194,7 +198,8 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
       if (!SelectFrontier(map, pose, t_s, &u)) {
         if (!(planner_.DistanceAt(pose.x, pose.y) > radius) && !frontiers_.empty()) {
           // Frontiers exist but the robot cannot move on this map yet: wait for the next one.
-          u.reason += (u.reason.empty() ? "" : "; ") + std::string("robot too close to obstacles or unknown space to plan, waiting");
+          u.reason += (u.reason.empty() ? "" : "; ") +
+                      std::string("robot too close to obstacles or unknown space to plan, waiting");
         } else {
           state_ = ExplorationState::kReturningHome;
           plan_home("(no reachable frontier left)");

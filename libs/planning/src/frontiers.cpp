@@ -70,7 +70,8 @@ bool SeesThrough(const mapping::OccupancyGrid& map, int ax, int ay, int bx, int 
   const int steps = 4 * std::max(std::abs(bx - ax), std::abs(by - ay));
   for (int k = 1; k < steps; ++k) {
     const double t = double(k) / steps;
-    const int x = static_cast<int>(std::lround(ax + t * (bx - ax))), y = static_cast<int>(std::lround(ay + t * (by - ay)));
+    const int x = static_cast<int>(std::lround(ax + t * (bx - ax))),
+              y = static_cast<int>(std::lround(ay + t * (by - ay)));
     if (map.at(x, y) > 0) return false;
   }
   return true;
@@ -126,7 +127,8 @@ std::vector<FrontierGoal> RankFrontierGoals(const std::vector<Frontier>& frontie
     g.cost = cost[best];
     goals.push_back(g);
   }
-  std::stable_sort(goals.begin(), goals.end(), [](const FrontierGoal& a, const FrontierGoal& b) { return a.cost < b.cost; });
+  std::stable_sort(goals.begin(), goals.end(),
+                   [](const FrontierGoal& a, const FrontierGoal& b) { return a.cost < b.cost; });
   return goals;
 }
 

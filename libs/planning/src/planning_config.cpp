@@ -10,11 +10,11 @@ AStarOptions ParseAStarOptions(config::Section& s, const AStarOptions& d) {
                                  "cells whose obstacle distance is at most this are never entered [m]", 0.0, 10.0);
   o.ease_start_m = s.GetDouble("ease_start_m", d.ease_start_m,
                                "easing: the first search asks this much more clearance than the radius [m]", 0.0, 10.0);
-  o.ease_step_m = s.GetDouble("ease_step_m", d.ease_step_m, "easing: clearance relaxed by this per failed search [m]",
-                              0.0, 10.0);
-  o.ease_max_m = s.GetDouble("ease_max_m", d.ease_max_m,
-                             "easing: relax at most this far below the first clearance, then search at the radius [m]",
-                             0.0, 10.0);
+  o.ease_step_m =
+      s.GetDouble("ease_step_m", d.ease_step_m, "easing: clearance relaxed by this per failed search [m]", 0.0, 10.0);
+  o.ease_max_m =
+      s.GetDouble("ease_max_m", d.ease_max_m,
+                  "easing: relax at most this far below the first clearance, then search at the radius [m]", 0.0, 10.0);
   o.penalty_range_m = s.GetDouble("penalty_range_m", d.penalty_range_m,
                                   "obstacle distance below which travel costs extra [m]", 0.0, 100.0);
   o.penalty_weight = s.GetDouble("penalty_weight", d.penalty_weight,
@@ -23,8 +23,9 @@ AStarOptions ParseAStarOptions(config::Section& s, const AStarOptions& d) {
                                    "shape of the penalty: weight * ((range - d) / range)^exponent", 0.1, 10.0);
   o.node_budget = s.GetInt("node_budget", d.node_budget, "expansions allowed per search (0: unlimited)", 0);
   const char* names[] = {"none", "collinear", "line_of_sight"};
-  const std::string prune = s.GetChoice("prune", names[static_cast<int>(d.prune)], {"none", "collinear", "line_of_sight"},
-                                        "waypoints kept: every cell, heading changes only, or line-of-sight shortcuts");
+  const std::string prune =
+      s.GetChoice("prune", names[static_cast<int>(d.prune)], {"none", "collinear", "line_of_sight"},
+                  "waypoints kept: every cell, heading changes only, or line-of-sight shortcuts");
   o.prune = prune == "none" ? PruneMode::kNone : prune == "collinear" ? PruneMode::kCollinear : PruneMode::kLineOfSight;
   return o;
 }
@@ -33,17 +34,18 @@ ObstacleDistanceOptions ParseObstacleDistanceOptions(config::Section& s, const O
   ObstacleDistanceOptions o = d;
   o.unknown_is_obstacle = s.GetBool("unknown_is_obstacle", d.unknown_is_obstacle,
                                     "unknown cells (log-odds 0) count as obstacles for distances and paths");
-  o.unknown_margin_m = s.GetDouble("unknown_margin_m", d.unknown_margin_m,
-                                   "with unknown_is_obstacle: unknown cells count as this much farther than they are [m]", 0.0, 10.0);
-  o.occupied_threshold = static_cast<int>(s.GetInt("occupied_threshold", d.occupied_threshold,
-                                                   "cells with log-odds above this are obstacles", -127, 126));
+  o.unknown_margin_m =
+      s.GetDouble("unknown_margin_m", d.unknown_margin_m,
+                  "with unknown_is_obstacle: unknown cells count as this much farther than they are [m]", 0.0, 10.0);
+  o.occupied_threshold = static_cast<int>(
+      s.GetInt("occupied_threshold", d.occupied_threshold, "cells with log-odds above this are obstacles", -127, 126));
   return o;
 }
 
 FrontierOptions ParseFrontierOptions(config::Section& s, const FrontierOptions& d) {
   FrontierOptions o = d;
-  o.min_cells = static_cast<int>(s.GetInt("min_frontier_cells", d.min_cells,
-                                          "frontier regions with fewer cells are ignored", 1, 1000000));
+  o.min_cells = static_cast<int>(
+      s.GetInt("min_frontier_cells", d.min_cells, "frontier regions with fewer cells are ignored", 1, 1000000));
   o.search_radius_m = s.GetDouble("frontier_search_radius_m", d.search_radius_m,
                                   "radius searched around a frontier's centroid for a reachable cell [m]", 0.0, 100.0);
   return o;
@@ -58,16 +60,17 @@ ExplorationOptions ParseExplorationOptions(config::Section& s, const Exploration
                                    "exploration is completed when the robot is this close to home [m]", 0.0, 10.0);
   o.target_reached_m = s.GetDouble("target_reached_m", d.target_reached_m,
                                    "a frontier target counts as reached this close [m]", 0.0, 10.0);
-  o.resolve_wait_s = s.GetDouble("resolve_wait_s", d.resolve_wait_s,
-                                 "a frontier still there this long after its target was reached is ignored for good [s]", 0.0, 600.0);
+  o.resolve_wait_s =
+      s.GetDouble("resolve_wait_s", d.resolve_wait_s,
+                  "a frontier still there this long after its target was reached is ignored for good [s]", 0.0, 600.0);
   o.blacklist_s = s.GetDouble("blacklist_s", d.blacklist_s,
                               "how long an unreachable or unresolvable frontier is ignored [s]", 0.0, 1e6);
-  o.blacklist_radius_m = s.GetDouble("blacklist_radius_m", d.blacklist_radius_m,
-                                     "frontiers whose centroid is this close to a blacklisted one are ignored too [m]",
-                                     0.0, 100.0);
-  o.frontier_match_m = s.GetDouble("frontier_match_m", d.frontier_match_m,
-                                   "the target frontier still exists while a frontier centroid is this close [m]", 0.0,
-                                   100.0);
+  o.blacklist_radius_m =
+      s.GetDouble("blacklist_radius_m", d.blacklist_radius_m,
+                  "frontiers whose centroid is this close to a blacklisted one are ignored too [m]", 0.0, 100.0);
+  o.frontier_match_m =
+      s.GetDouble("frontier_match_m", d.frontier_match_m,
+                  "the target frontier still exists while a frontier centroid is this close [m]", 0.0, 100.0);
   return o;
 }
 

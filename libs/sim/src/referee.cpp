@@ -196,13 +196,16 @@ Score Referee::Judge() const {
                        s.completed ? PosePoints(e) : 0});
     const MapQuality mq = map_ ? Quality(world_, *map_, s.start) : MapQuality{};
     s.map = mq;
-    s.items.push_back({"map quality",
-                       "coverage " + Fixed(100 * mq.coverage, 3) + " %, walls " + Fixed(100 * mq.precision, 3) + " % within 1.5 cells",
-                       static_cast<int>(std::floor(100.0 * std::min(1.0, std::min(mq.coverage / 0.99, mq.precision / 0.95))))});
+    s.items.push_back(
+        {"map quality",
+         "coverage " + Fixed(100 * mq.coverage, 3) + " %, walls " + Fixed(100 * mq.precision, 3) +
+             " % within 1.5 cells",
+         static_cast<int>(std::floor(100.0 * std::min(1.0, std::min(mq.coverage / 0.99, mq.precision / 0.95))))});
     if (o_.event == CompetitionEvent::kSpeedRun) {
       s.items.push_back({"lap time", Fixed(s.time_s, 4) + " s", s.completed ? LapPoints(s.time_s) : 0});
     } else {
-      s.items.push_back({"autonomy", s.completed ? "explored and home, no help" : "not completed", s.completed ? 100 : 0});
+      s.items.push_back(
+          {"autonomy", s.completed ? "explored and home, no help" : "not completed", s.completed ? 100 : 0});
     }
   } else {
     if (localized_us_ >= 0) s.localized_at_s = (localized_us_ - t0_us_) * 1e-6;

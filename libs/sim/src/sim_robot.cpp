@@ -241,14 +241,12 @@ struct SimRobot::Impl {
     const double dt = fw_us * 1e-6;
     const double wl = pl * dl * rad_per_tick / dt, wr = pr * dr * rad_per_tick / dt;
     out->push_back(MakeEvent(now, sim_channel::kEncoders, EventKind::kEncoders, EncoderTicks{tl, tr, dl, dr, fw_us}));
-    out->push_back(MakeEvent(now, sim_channel::kMotorVel, EventKind::kWheelSpeed,
-                             WheelSpeeds{wl, wr}));
+    out->push_back(MakeEvent(now, sim_channel::kMotorVel, EventKind::kWheelSpeed, WheelSpeeds{wl, wr}));
     out->push_back(MakeEvent(now, sim_channel::kOdometry, EventKind::kOdometry, odometry.AddEncoders(now, tl, tr)));
     const motion::WheelDuties duties = controller.Update(cmd_v, cmd_w, wl, wr);
     duty_l = duties.left;
     duty_r = duties.right;
-    out->push_back(MakeEvent(now, sim_channel::kMotorPwm, EventKind::kMotorCommand,
-                             MotorCommand::Pwm(duty_l, duty_r)));
+    out->push_back(MakeEvent(now, sim_channel::kMotorPwm, EventKind::kMotorCommand, MotorCommand::Pwm(duty_l, duty_r)));
   }
 
   void AdvanceTo(int64_t t_end, std::vector<Event>* out) {
@@ -302,11 +300,11 @@ struct SimRobot::Impl {
   // Truth.
   Pose2D pose;
   double cmd_v = 0.0, cmd_w = 0.0;
-  double duty_l = 0.0, duty_r = 0.0;      // what the firmware sent last
-  double w_l = 0.0, w_r = 0.0;            // wheel rotational speeds [rad/s]
-  double angle_l = 0.0, angle_r = 0.0;    // cumulative wheel rotation [rad]
-  double slip_l = 0.0, slip_r = 0.0;      // relative ground-speed errors
-  double body_v = 0.0, body_rate = 0.0;   // over the last physics step
+  double duty_l = 0.0, duty_r = 0.0;     // what the firmware sent last
+  double w_l = 0.0, w_r = 0.0;           // wheel rotational speeds [rad/s]
+  double angle_l = 0.0, angle_r = 0.0;   // cumulative wheel rotation [rad]
+  double slip_l = 0.0, slip_r = 0.0;     // relative ground-speed errors
+  double body_v = 0.0, body_rate = 0.0;  // over the last physics step
   int collisions = 0;
   bool contact = false;
   double distance = 0.0;
@@ -343,9 +341,7 @@ double SimRobot::distance_travelled_m() const { return impl_->distance; }
 double SimRobot::left_wheel_speed_rad_s() const { return impl_->w_l; }
 double SimRobot::right_wheel_speed_rad_s() const { return impl_->w_r; }
 int64_t SimRobot::left_ticks() const { return impl_->Ticks(impl_->angle_l, impl_->o.geometry.left_encoder_polarity); }
-int64_t SimRobot::right_ticks() const {
-  return impl_->Ticks(impl_->angle_r, impl_->o.geometry.right_encoder_polarity);
-}
+int64_t SimRobot::right_ticks() const { return impl_->Ticks(impl_->angle_r, impl_->o.geometry.right_encoder_polarity); }
 double SimRobot::gyro_bias_rad_s() const { return impl_->bias; }
 const SimRobotOptions& SimRobot::options() const { return impl_->o; }
 

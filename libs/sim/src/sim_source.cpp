@@ -70,7 +70,9 @@ std::optional<Event> SimSource::Next() {
     if (ended_ || now >= duration_us_) return std::nullopt;
     const int64_t step = std::max<int64_t>(1, std::llround(robot_->options().physics_dt_s * 1e6));
     if (realtime_factor_ > 0) {  // keep simulated time with the wall clock, from the first event asked for
-      if (!paced_) paced_ = true, wall0_ = std::chrono::steady_clock::now() - std::chrono::microseconds(static_cast<int64_t>(now / realtime_factor_));
+      if (!paced_)
+        paced_ = true, wall0_ = std::chrono::steady_clock::now() -
+                                std::chrono::microseconds(static_cast<int64_t>(now / realtime_factor_));
       std::this_thread::sleep_until(wall0_ + std::chrono::microseconds(static_cast<int64_t>(now / realtime_factor_)));
     }
     robot_->AdvanceTo(std::min(now + step, duration_us_), &buffer_);
@@ -105,8 +107,9 @@ void SimSource::Send(const Event& event) {
 void RegisterSimSource() {
   if (drivers::FindSourceType("sim")) return;
   drivers::RegisterSourceType(
-      {"sim", "the simulated MBot on a world (.arena, or a map whose unknown and occupied cells are walls); its keys "
-              "are the simulator's",
+      {"sim",
+       "the simulated MBot on a world (.arena, or a map whose unknown and occupied cells are walls); its keys "
+       "are the simulator's",
        [](const std::string& path) { return EndsWith(path, ".arena"); }, 0,
        [](config::Section& s, SourceOptions* o) { o->extra = ParseSimSourceOptions(s, o->path); },
        [](const SourceOptions& o) -> std::unique_ptr<drivers::Source> {

@@ -13,24 +13,29 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& wo
   const auto doc = [](const char* text) { return std::string("simulator: ") + text; };
   SimSourceOptions o;
   const std::vector<std::string> start =
-      s.GetList("start", {}, doc("where the robot starts, in the world frame: x [m], y [m], theta [deg], or 'random' "
-                                 "(a seeded draw from the reachable free space); default: the arena's 'start' pose "
-                                 "(required for a map world)"));
+      s.GetList("start", {},
+                doc("where the robot starts, in the world frame: x [m], y [m], theta [deg], or 'random' "
+                    "(a seeded draw from the reachable free space); default: the arena's 'start' pose "
+                    "(required for a map world)"));
   o.random_start_clearance_m = s.GetDouble("random_start_clearance_m", o.random_start_clearance_m,
                                            doc("start = random keeps this far from every wall [m]"), 0.0, 10.0);
   if (start.size() == 1 && start[0] == "random") {
     o.random_start = true;
   } else if (!start.empty()) {
-    if (start.size() != 3) s.Fail("start", "expected x, y, theta_deg (3 numbers) or 'random', got " + std::to_string(start.size()) + " items");
+    if (start.size() != 3)
+      s.Fail("start",
+             "expected x, y, theta_deg (3 numbers) or 'random', got " + std::to_string(start.size()) + " items");
     const config::PoseValue p = s.GetPose("start", {}, "");
     o.start = motion::Pose2D{p.x_m, p.y_m, motion::WrapAngle(p.theta_rad)};
   } else if (!s.describing() && !EndsWith(world_path, ".arena")) {
     s.Fail("start", "required: the world '" + world_path + "' is a map, which names no start pose");
   }
-  o.duration_s = s.GetDouble("duration_s", o.duration_s, doc("simulated time after which the run ends [s]"), 0.001, 1e6);
+  o.duration_s =
+      s.GetDouble("duration_s", o.duration_s, doc("simulated time after which the run ends [s]"), 0.001, 1e6);
   o.realtime_factor = s.GetDouble("realtime_factor", o.realtime_factor,
                                   doc("0: as fast as possible; else simulated time runs this many times the wall clock "
-                                      "(1 for the simulated robot on the LCM bus)"), 0.0, 1000.0);
+                                      "(1 for the simulated robot on the LCM bus)"),
+                                  0.0, 1000.0);
   if (o.realtime_factor > 0 && o.realtime_factor < 0.01) s.Fail("realtime_factor", "must be 0 (off) or at least 0.01");
 
   SimRobotOptions& r = o.robot;
@@ -38,16 +43,17 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& wo
   r.footprint_radius_m =
       s.GetDouble("footprint_radius_m", r.footprint_radius_m,
                   doc("radius of the robot's disc footprint; touching a wall with it stops the robot [m]"), 0.01, 1.0);
-  r.left_motor_gain =
-      s.GetDouble("left_motor_gain", r.left_motor_gain,
-                  doc("true left wheel speed / the speed the motor model gives its duty (per-wheel difference)"), 0.5, 1.5);
+  r.left_motor_gain = s.GetDouble(
+      "left_motor_gain", r.left_motor_gain,
+      doc("true left wheel speed / the speed the motor model gives its duty (per-wheel difference)"), 0.5, 1.5);
   r.right_motor_gain = s.GetDouble("right_motor_gain", r.right_motor_gain,
                                    doc("true right wheel speed / the speed the motor model gives its duty"), 0.5, 1.5);
   r.motor_time_constant_s =
       s.GetDouble("motor_time_constant_s", r.motor_time_constant_s,
                   doc("first-order lag of a wheel's speed behind its duty's steady state [s]"), 0.0, 1.0);
-  r.slip_stddev = s.GetDouble("slip_stddev", r.slip_stddev,
-                              doc("relative error of each wheel's ground speed against its rotation (std. dev.)"), 0.0, 0.5);
+  r.slip_stddev =
+      s.GetDouble("slip_stddev", r.slip_stddev,
+                  doc("relative error of each wheel's ground speed against its rotation (std. dev.)"), 0.0, 0.5);
   r.slip_interval_s =
       s.GetDouble("slip_interval_s", r.slip_interval_s, doc("how often each wheel's slip is redrawn [s]"), 0.001, 10.0);
   const double firmware_rate_hz =
@@ -56,8 +62,8 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& wo
                       "messages [Hz]"),
                   5.0, 1000.0);
   r.controller.dt_s = 1.0 / firmware_rate_hz;
-  r.ground_truth_rate_hz =
-      s.GetDouble("ground_truth_rate_hz", r.ground_truth_rate_hz, doc("rate of the TRUE_POSE messages [Hz]"), 1.0, 1000.0);
+  r.ground_truth_rate_hz = s.GetDouble("ground_truth_rate_hz", r.ground_truth_rate_hz,
+                                       doc("rate of the TRUE_POSE messages [Hz]"), 1.0, 1000.0);
 
   SimImuOptions& imu = r.imu;
   imu.rate_hz = s.GetDouble("imu_rate_hz", imu.rate_hz, doc("rate of the IMU messages [Hz]"), 1.0, 1000.0);
@@ -78,8 +84,7 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& wo
   if (l.min_range_m >= l.max_range_m) s.Fail("lidar_min_range_m", "must be below lidar_max_range_m");
   l.range_noise_m =
       s.GetDouble("lidar_range_noise_m", l.range_noise_m, doc("lidar range noise, standard deviation [m]"), 0.0, 1.0);
-  l.dropout =
-      s.GetDouble("lidar_dropout", l.dropout, doc("probability that a lidar beam gives no return"), 0.0, 1.0);
+  l.dropout = s.GetDouble("lidar_dropout", l.dropout, doc("probability that a lidar beam gives no return"), 0.0, 1.0);
   return o;
 }
 

@@ -534,8 +534,9 @@ bool World::Collides(double x, double y, double radius_m) const {
     if (truth_.at(cx, cy) > 0) return true;
     if (index_->any_wall_cell) {
       // Quick reject: the distance transform bounds the clearance from below by D − √2 cells.
-      const double lower = (index_->centre_distance[static_cast<size_t>(cy) * truth_.width() + cx] - std::sqrt(2.0) - 1e-3) *
-                           truth_.resolution();
+      const double lower =
+          (index_->centre_distance[static_cast<size_t>(cy) * truth_.width() + cx] - std::sqrt(2.0) - 1e-3) *
+          truth_.resolution();
       if (lower > r) return false;
     }
     return GridClearance(truth_, *index_, x, y) <= r;

@@ -108,17 +108,15 @@ class Section {
                    double max = std::numeric_limits<double>::infinity());
   bool GetBool(const std::string& key, bool def, const std::string& doc);
   // Comma-separated list; whitespace around items is trimmed, empty items dropped.
-  std::vector<std::string> GetList(const std::string& key, const std::vector<std::string>& def,
-                                   const std::string& doc);
+  std::vector<std::string> GetList(const std::string& key, const std::vector<std::string>& def, const std::string& doc);
   // One of `choices`; anything else is an error listing them.
-  std::string GetChoice(const std::string& key, const std::string& def,
-                        const std::vector<std::string>& choices, const std::string& doc);
+  std::string GetChoice(const std::string& key, const std::string& def, const std::vector<std::string>& choices,
+                        const std::string& doc);
 
   // One pose, `x, y, theta_deg` (see PoseValue).
   PoseValue GetPose(const std::string& key, const PoseValue& def, const std::string& doc);
   // Poses, `x, y, theta_deg` each, separated by `;` (or all by commas, in threes).
-  std::vector<PoseValue> GetPoses(const std::string& key, const std::vector<PoseValue>& def,
-                                  const std::string& doc);
+  std::vector<PoseValue> GetPoses(const std::string& key, const std::vector<PoseValue>& def, const std::string& doc);
   // One of an enum's names; anything else is an error listing them.
   template <typename E>
   E GetEnum(const std::string& key, E def, const std::vector<std::pair<std::string, E>>& names,
@@ -149,8 +147,8 @@ class Section {
   bool describing() const { return entries_ == nullptr; }
 
  private:
-  const Entry* Find(const std::string& key, const std::string& type, const std::string& def,
-                    bool required, const std::string& doc);
+  const Entry* Find(const std::string& key, const std::string& type, const std::string& def, bool required,
+                    const std::string& doc);
   std::string Expand(const Entry& entry, const std::string& key) const;
 
   std::string name_;

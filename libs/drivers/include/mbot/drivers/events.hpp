@@ -17,21 +17,21 @@
 namespace mbot::drivers {
 
 struct LidarScan {
-  std::vector<float> ranges_m;          // <= 0 or NaN: no return
-  std::vector<float> angles_rad;        // per beam, counter-clockwise in the sensor frame (any 2π range)
-  std::vector<int64_t> beam_times_us;   // per beam when the source has them, else empty
-  std::vector<float> intensities;       // empty when absent
-  float max_range_m = 0.0f;             // 0 when the source does not say
+  std::vector<float> ranges_m;         // <= 0 or NaN: no return
+  std::vector<float> angles_rad;       // per beam, counter-clockwise in the sensor frame (any 2π range)
+  std::vector<int64_t> beam_times_us;  // per beam when the source has them, else empty
+  std::vector<float> intensities;      // empty when absent
+  float max_range_m = 0.0f;            // 0 when the source does not say
   // Sensor pose on the robot when the source gives one (rawlogs, CARMEN ROBOTLASER).
   motion::Pose2D sensor_pose;
 };
 
 struct EncoderTicks {
-  int64_t left_ticks = 0;    // cumulative
+  int64_t left_ticks = 0;  // cumulative
   int64_t right_ticks = 0;
-  int32_t left_delta = 0;    // since the previous message, when the source gives it
+  int32_t left_delta = 0;  // since the previous message, when the source gives it
   int32_t right_delta = 0;
-  int64_t delta_time_us = 0; // 0 when the source does not say
+  int64_t delta_time_us = 0;  // 0 when the source does not say
 };
 
 struct Imu {
@@ -111,13 +111,13 @@ enum class EventKind {
 
 const char* ToString(EventKind kind);
 
-using Payload = std::variant<std::monostate, LidarScan, motion::Pose2D, EncoderTicks, Imu,
-                             MotorCommand, WheelSpeeds, std::shared_ptr<const mapping::OccupancyGrid>, PlanRequest,
-                             WheelSample, Path, mapping::SlamStatus, mission::MissionStatus, Particles>;
+using Payload = std::variant<std::monostate, LidarScan, motion::Pose2D, EncoderTicks, Imu, MotorCommand, WheelSpeeds,
+                             std::shared_ptr<const mapping::OccupancyGrid>, PlanRequest, WheelSample, Path,
+                             mapping::SlamStatus, mission::MissionStatus, Particles>;
 
 struct Event {
-  int64_t t_us = 0;       // event (reception / log) time; the order of the stream
-  int64_t stamp_us = 0;   // the message's own timestamp when it has one (may use another clock)
+  int64_t t_us = 0;      // event (reception / log) time; the order of the stream
+  int64_t stamp_us = 0;  // the message's own timestamp when it has one (may use another clock)
   std::string channel;
   EventKind kind = EventKind::kOther;
   Payload payload;

@@ -22,12 +22,12 @@ namespace mbot::drivers {
 inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";  // ttl=0: this machine only
 
 struct LcmChannelStats {
-  long long received = 0;   // messages that arrived
-  long long rejected = 0;   // malformed: not passed on
-  long long unknown = 0;    // of a type nobody knows
-  long long published = 0;  // messages this node sent
-  long long own_echoes = 0; // this node's own messages looping back (multicast), ignored
-  std::string last_error;   // why the last rejected one was
+  long long received = 0;    // messages that arrived
+  long long rejected = 0;    // malformed: not passed on
+  long long unknown = 0;     // of a type nobody knows
+  long long published = 0;   // messages this node sent
+  long long own_echoes = 0;  // this node's own messages looping back (multicast), ignored
+  std::string last_error;    // why the last rejected one was
 };
 
 class LcmNode {

@@ -65,7 +65,7 @@ class LcmLogWriter {
 
 // Appends the big-endian encoding of an LCM record to `out` (exposed so tests can build corrupt
 // logs byte by byte).
-void AppendLcmRecord(std::vector<uint8_t>& out, int64_t event_number, int64_t timestamp_us,
-                     const std::string& channel, const std::vector<uint8_t>& data);
+void AppendLcmRecord(std::vector<uint8_t>& out, int64_t event_number, int64_t timestamp_us, const std::string& channel,
+                     const std::vector<uint8_t>& data);
 
 }  // namespace mbot::drivers

@@ -1,5 +1,6 @@
 // Occupancy-grid file formats: botlab `.map`, ROS map_server PGM + YAML, MRPT `.gridmap(.gz)`,
-// MRPT `.simplemap(.gz)` (rendered to a grid), Moving AI `.map`, and PNG pictures. Readers throw std::runtime_error naming the file (and line).
+// MRPT `.simplemap(.gz)` (rendered to a grid), Moving AI `.map`, and PNG pictures. Readers throw std::runtime_error
+// naming the file (and line).
 #pragma once
 
 #include <cstdint>
@@ -50,8 +51,8 @@ struct MapOverlay {
 };
 
 // The map picture in colour, `scale` pixels per cell, with the overlays drawn in order and a legend.
-void WriteMapPngWithOverlays(const mapping::OccupancyGrid& grid, const std::vector<MapOverlay>& overlays,
-                             int scale, const std::string& path);
+void WriteMapPngWithOverlays(const mapping::OccupancyGrid& grid, const std::vector<MapOverlay>& overlays, int scale,
+                             const std::string& path);
 
 // An OctoMap (.bt) of the grid for 3D viewers: occupied cells become columns from z = 0 to
 // `wall_height_m`, free cells a free floor layer, at the grid's resolution.

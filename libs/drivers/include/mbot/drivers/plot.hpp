@@ -11,8 +11,8 @@ namespace mbot::drivers {
 struct PlotSeries {
   std::vector<double> x, y;  // same length; non-finite points are skipped
   uint8_t r = 0, g = 0, b = 0;
-  bool points = false;       // dots instead of a polyline
-  std::string label;         // in the legend when non-empty
+  bool points = false;  // dots instead of a polyline
+  std::string label;    // in the legend when non-empty
 };
 
 struct PlotOptions {

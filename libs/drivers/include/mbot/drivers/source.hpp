@@ -19,7 +19,7 @@ struct ChannelInfo {
   std::string type;        // message / observation type, e.g. "lidar_t", "CObservation2DRangeScan"
   std::string generation;  // message generation(s), e.g. "legacy 2017-2022", or "" when n/a
   EventKind kind = EventKind::kOther;
-  bool decoded = true;     // false when the type is unknown and the messages are skipped
+  bool decoded = true;  // false when the type is unknown and the messages are skipped
 };
 
 // Problems met while reading; each was also logged with its location.

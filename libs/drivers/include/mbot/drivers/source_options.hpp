@@ -29,16 +29,16 @@ struct ChannelRoles {
 // [source] type = lcm_live: a robot (or the simulated one) on the LCM bus, in wall-clock time.
 struct LiveSourceOptions {
   // The robot's channels the autonomy listens to (current mbot_lcm_msgs names).
-  std::vector<std::string> channels = {"LIDAR", "MBOT_ODOMETRY", "MBOT_ENCODERS", "MBOT_IMU",
+  std::vector<std::string> channels = {"LIDAR",         "MBOT_ODOMETRY",   "MBOT_ENCODERS",    "MBOT_IMU",
                                        "MBOT_TIMESYNC", "CONTROLLER_PATH", "MBOT_SYSTEM_RESET"};
-  double duration_s = 0.0;             // 0: until Ctrl-C or a stage ends the run
-  double end_after_silence_s = 0.0;    // > 0: the run ends when nothing arrived for this long
+  double duration_s = 0.0;           // 0: until Ctrl-C or a stage ends the run
+  double end_after_silence_s = 0.0;  // > 0: the run ends when nothing arrived for this long
   // A watched channel silent this long is reported and the robot stopped (zero velocity published,
   // commands held back) until it is back.
   double stale_sensor_s = 1.0;
   std::vector<std::string> watched = {"LIDAR", "MBOT_ODOMETRY"};
   std::string command_channel = "MBOT_VEL_CMD";
-  double report_every_s = 10.0;        // a line with the loop rate and latency this often (0: never)
+  double report_every_s = 10.0;  // a line with the loop rate and latency this often (0: never)
 };
 
 struct SourceOptions {

@@ -11,8 +11,8 @@
 namespace mbot::mapping {
 
 struct ActionModelOptions {
-  double k1 = 0.005;               // rotation noise [rad per rad]
-  double k2 = 0.005;               // translation noise [m per m]
+  double k1 = 0.005;  // rotation noise [rad per rad]
+  double k2 = 0.005;  // translation noise [m per m]
   double min_sigma_trans_m = 0.002;
   double min_sigma_rot_rad = 0.002;
   // The filter updates only once odometry moved at least this far or turned this much.

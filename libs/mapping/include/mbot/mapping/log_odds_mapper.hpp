@@ -12,7 +12,7 @@
 namespace mbot::mapping {
 
 struct MapperOptions {
-  int hit_odds = 5;     // the seed report's choice (sharpest walls on the botlab logs)
+  int hit_odds = 5;  // the seed report's choice (sharpest walls on the botlab logs)
   int miss_odds = 1;
   double resolution_m = 0.05;
   // Initial extent, centred on (center_x_m, center_y_m).
@@ -20,8 +20,8 @@ struct MapperOptions {
   double height_m = 10.0;
   double center_x_m = 0.0;
   double center_y_m = 0.0;
-  bool grow = true;          // false: rays leaving the extent are clipped
-  double grow_block_m = 5.0; // the extent grows by multiples of this
+  bool grow = true;           // false: rays leaving the extent are clipped
+  double grow_block_m = 5.0;  // the extent grows by multiples of this
 };
 
 class LogOddsMapper {

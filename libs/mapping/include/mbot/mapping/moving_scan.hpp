@@ -17,8 +17,8 @@ struct ScanRay {
 };
 
 struct ScanOptions {
-  double min_range_m = 0.10;   // shorter returns hit the robot itself and are dropped
-  double max_range_m = 0.0;    // returns at or beyond this are misses; 0: the sensor's own maximum
+  double min_range_m = 0.10;       // shorter returns hit the robot itself and are dropped
+  double max_range_m = 0.0;        // returns at or beyond this are misses; 0: the sensor's own maximum
   double no_return_clear_m = 0.0;  // a beam with no return clears this far; 0: not at all
 };
 
@@ -28,8 +28,7 @@ struct ScanOptions {
 // `sensor_max_range_m` is what the sensor reported (0 when unknown).
 std::vector<ScanRay> DeskewScan(const std::vector<float>& ranges, const std::vector<float>& angles,
                                 const std::vector<float>& fractions, const motion::Pose2D& start_in_end,
-                                const motion::Pose2D& sensor, double sensor_max_range_m,
-                                const ScanOptions& options);
+                                const motion::Pose2D& sensor, double sensor_max_range_m, const ScanOptions& options);
 
 // When each beam of a scan was measured. kBeams: the scan's own per-beam times; kSpread: beams evenly
 // over the time since the previous scan (a spinning lidar without usable beam times); kNone: all at
@@ -38,8 +37,8 @@ std::vector<ScanRay> DeskewScan(const std::vector<float>& ranges, const std::vec
 enum class BeamTiming { kAuto, kBeams, kSpread, kNone };
 
 struct BeamTimes {
-  std::vector<float> fractions;  // per beam, 0 = the scan's start, 1 = its end; empty: no deskew
-  int64_t duration_us = 0;       // from the scan's start to its end
+  std::vector<float> fractions;      // per beam, 0 = the scan's start, 1 = its end; empty: no deskew
+  int64_t duration_us = 0;           // from the scan's start to its end
   bool beam_times_unusable = false;  // kBeams was asked for, but the beam times do not span the scan
 };
 

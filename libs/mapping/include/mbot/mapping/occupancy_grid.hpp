@@ -13,8 +13,7 @@ class OccupancyGrid {
   OccupancyGrid() = default;
   // A width × height grid of `resolution_m` cells whose lower-left corner is (origin_x_m, origin_y_m),
   // every cell set to `fill`.
-  OccupancyGrid(int width, int height, double resolution_m, double origin_x_m, double origin_y_m,
-                int8_t fill = 0);
+  OccupancyGrid(int width, int height, double resolution_m, double origin_x_m, double origin_y_m, int8_t fill = 0);
 
   int width() const { return width_; }
   int height() const { return height_; }

@@ -29,8 +29,8 @@ struct SearchBox {
 
 struct ParticleFilterOptions {
   int particles = 1000;
-  double top_fraction = 0.15;     // the estimate is the weighted mean of this share of the best particles
-  int threads = 0;                // 0: all cores
+  double top_fraction = 0.15;  // the estimate is the weighted mean of this share of the best particles
+  int threads = 0;             // 0: all cores
   // Global localization (and relocalization when lost).
   int global_particles = 20000;
   // When set, the initial global search draws only from the free cells inside this box (what the
@@ -47,7 +47,7 @@ struct ParticleFilterOptions {
   bool augmented = false;
   double alpha_slow = 0.02;
   double alpha_fast = 0.3;
-  double max_injection = 0.05;    // at most this share of the particles is replaced per update
+  double max_injection = 0.05;  // at most this share of the particles is replaced per update
   // Lost: the estimate's inlier share stays below lost_inlier_fraction, or the short-term scan fit
   // below lost_fit_ratio times the long-term one, for `lost_scans` updates in a row.
   double lost_inlier_fraction = 0.4;
@@ -58,16 +58,16 @@ struct ParticleFilterOptions {
 
 struct FilterStatus {
   motion::Pose2D pose;
-  double ess = 0.0;            // effective sample size after weighing
+  double ess = 0.0;  // effective sample size after weighing
   int particles = 0;
   int injected = 0;            // random particles injected by augmented MCL this update
   double inlier_fraction = 0;  // of the scan at the estimate
   double fit_ratio = 1;        // short-term over long-term scan-fit average (augmented MCL's signal)
   double spread_m = 0;         // weighted standard deviation of the particle positions
   bool lost = false;
-  bool relocalized = false;    // the filter was re-spread over the free space after this update
-  bool converged = true;       // false while a global search has not settled
-  double tempering = 1.0;      // exponent applied to the scan likelihood this update (< 1 while searching)
+  bool relocalized = false;  // the filter was re-spread over the free space after this update
+  bool converged = true;     // false while a global search has not settled
+  double tempering = 1.0;    // exponent applied to the scan likelihood this update (< 1 while searching)
 };
 
 class ParticleFilter {

@@ -20,13 +20,13 @@ enum class SensorModelKind { kLikelihoodField, kSimplifiedField };
 
 struct SensorModelOptions {
   SensorModelKind kind = SensorModelKind::kLikelihoodField;
-  int ray_stride = 1;              // use every k-th hit ray
-  int occupied_threshold = 0;      // log-odds above this count as obstacles
-  double log_scale = 1.0;          // multiplies the summed per-beam log-likelihood
+  int ray_stride = 1;          // use every k-th hit ray
+  int occupied_threshold = 0;  // log-odds above this count as obstacles
+  double log_scale = 1.0;      // multiplies the summed per-beam log-likelihood
   // Likelihood field.
   double sigma_m = 0.05;
-  double max_distance_m = 0.5;     // distances are clamped here (also the value off the map)
-  double random_weight = 0.05;     // uniform share for unexplained returns, relative to the Gaussian peak
+  double max_distance_m = 0.5;  // distances are clamped here (also the value off the map)
+  double random_weight = 0.05;  // uniform share for unexplained returns, relative to the Gaussian peak
   // Simplified likelihood field: log-likelihood per log-odds unit, and the weight of a neighbour cell.
   double odds_scale = 0.02;
   double neighbour_weight = 0.5;
@@ -61,12 +61,12 @@ class SensorModel {
   SensorModelOptions options_;
   int width_ = 0, height_ = 0;
   double resolution_ = 0.05, origin_x_ = 0, origin_y_ = 0;
-  std::vector<float> table_;    // simplified field: per-cell scaled log-odds
+  std::vector<float> table_;  // simplified field: per-cell scaled log-odds
   // Likelihood field: per-cell log-likelihood with a one-cell border holding the off-map value, so
   // the inner loop clamps its indices instead of branching: (width + 2) × (height + 2).
   std::vector<float> padded_;
-  std::vector<uint8_t> inlier_; // per cell: within inlier_distance_m of an obstacle
-  float off_map_ = 0.0f;        // value of a point off the map
+  std::vector<uint8_t> inlier_;    // per cell: within inlier_distance_m of an obstacle
+  float off_map_ = 0.0f;           // value of a point off the map
   std::vector<uint8_t> obstacle_;  // the obstacle mask the distance tables were built from
   int reach_cells_ = 0;            // distances beyond this many cells all score as "far"
   std::vector<float> field_lut_;   // likelihood-field value by squared distance in cells²

@@ -114,8 +114,8 @@ class Slam {
   ParticleFilter filter_;
   bool initialized_ = false;
   bool sensor_stale_ = true;
-  motion::Pose2D last_odometry_;   // odometry at the last filter update
-  motion::Pose2D last_estimate_;   // the estimate then
+  motion::Pose2D last_odometry_;  // odometry at the last filter update
+  motion::Pose2D last_estimate_;  // the estimate then
 };
 
 }  // namespace mbot::mapping

@@ -45,11 +45,11 @@ struct MissionOptions {
   // The wheels answer a command late (the firmware filters v, ω and the PWM; the motors lag): the
   // controller is given the pose predicted this far ahead at the measured velocity.
   double control_lag_s = 0.2;
-  int max_corrections = 5;      // times the final pose is driven to again after stopping outside the tolerances
-  double stuck_s = 1.0;         // commanded to move but not moving this long: back off
-  double backoff_s = 0.6;       // reversing at 0.1 m/s
-  int max_stalls = 10;          // stalls on the way to one goal before the mission gives up
-  double dwell_s = 2.5;         // warehouse: standing at a stop (lifting, setting down) [s]
+  int max_corrections = 5;  // times the final pose is driven to again after stopping outside the tolerances
+  double stuck_s = 1.0;     // commanded to move but not moving this long: back off
+  double backoff_s = 0.6;   // reversing at 0.1 m/s
+  int max_stalls = 10;      // stalls on the way to one goal before the mission gives up
+  double dwell_s = 2.5;     // warehouse: standing at a stop (lifting, setting down) [s]
 };
 
 // What the mission asks the caller to do, in order: publish a state, publish a path (the
@@ -121,7 +121,7 @@ class Mission {
   std::unique_ptr<Task> task_;
   motion::MotionController controller_;
   std::vector<MissionOutput>* out_ = nullptr;  // during OnOdometry
-  int64_t t_us_ = 0;                          // the step's time
+  int64_t t_us_ = 0;                           // the step's time
   motion::TimedPose slam_;
   bool has_slam_ = false;
   int64_t first_slam_us_ = -1, last_control_us_ = -1;

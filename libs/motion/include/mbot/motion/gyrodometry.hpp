@@ -22,10 +22,11 @@ enum class HeadingSource { kEncoders, kGyrodometry, kComplementary, kImuYaw };
 
 struct GyrodometryOptions {
   HeadingSource heading = HeadingSource::kGyrodometry;
-  double threshold_rad_s = 0.1;   // gyrodometry: use the gyro when the rates differ by more than this (best of 0.02–0.2 on sweep_drive_square)
-  double gyro_weight = 0.98;      // complementary: share of the gyro's heading change
-  double gyro_scale = 1.0;        // multiplies the gyro rate (calibration)
-  bool estimate_bias = true;      // average the gyro while the wheels have not moved yet
+  double threshold_rad_s = 0.1;  // gyrodometry: use the gyro when the rates differ by more than this (best of 0.02–0.2
+                                 // on sweep_drive_square)
+  double gyro_weight = 0.98;  // complementary: share of the gyro's heading change
+  double gyro_scale = 1.0;    // multiplies the gyro rate (calibration)
+  bool estimate_bias = true;  // average the gyro while the wheels have not moved yet
 };
 
 class Gyrodometry {

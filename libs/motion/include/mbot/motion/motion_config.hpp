@@ -15,7 +15,8 @@ namespace mbot::motion {
 // Keys controller (rotate_translate_rotate | pure_pursuit), max_speed_m_s, max_turn_rate_rad_s,
 // max_accel_m_s2, max_angular_accel_rad_s2, final_tolerance_m, intermediate_tolerance_m,
 // final_heading_tolerance_rad, lookahead_m, reverse_within_m.
-MotionControllerOptions ParseMotionControllerOptions(config::Section& section, const MotionControllerOptions& defaults = {});
+MotionControllerOptions ParseMotionControllerOptions(config::Section& section,
+                                                     const MotionControllerOptions& defaults = {});
 
 // Reads the robot's geometry (wheel_diameter_m, base_radius_m, gear_ratio, encoder_resolution,
 // left/right_encoder_polarity; classic MBot by default) and the optional per-tick overrides

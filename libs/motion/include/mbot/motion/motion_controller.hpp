@@ -33,8 +33,8 @@ struct MotionControllerOptions {
   double max_turn_rate_rad_s = 2.5;
   double max_accel_m_s2 = 0.5;
   double max_angular_accel_rad_s2 = 6.0;
-  double final_tolerance_m = 0.02;          // position tolerance at the last waypoint
-  double intermediate_tolerance_m = 0.08;   // radius at which an intermediate waypoint counts as passed
+  double final_tolerance_m = 0.02;         // position tolerance at the last waypoint
+  double intermediate_tolerance_m = 0.08;  // radius at which an intermediate waypoint counts as passed
   double final_heading_tolerance_rad = 0.05;
   // Beyond this bearing error to the target the robot turns in place (v = 0) instead of driving an
   // arc; RTR also comes to a stop at waypoints where the path turns by more than this.
@@ -52,7 +52,7 @@ struct MotionControllerOptions {
 };
 
 struct ControllerProgress {
-  size_t waypoint_index = 0;        // waypoint being driven to; waypoint_count once arrived
+  size_t waypoint_index = 0;  // waypoint being driven to; waypoint_count once arrived
   size_t waypoint_count = 0;
   double distance_to_goal_m = 0.0;  // straight line from the last pose given to Update to the final waypoint
   bool arrived = false;

@@ -17,9 +17,9 @@ struct MotorLine {
 };
 
 struct WheelCalibration {
-  int motor_polarity = 1;    // +1: a positive duty turns the wheel forward
-  int encoder_polarity = 1;  // +1: the encoder counts up when the wheel turns forward
-  MotorLine forward{0.068, 0.068};    // the seed report's Table III means (both wheels, 6 calibrations)
+  int motor_polarity = 1;           // +1: a positive duty turns the wheel forward
+  int encoder_polarity = 1;         // +1: the encoder counts up when the wheel turns forward
+  MotorLine forward{0.068, 0.068};  // the seed report's Table III means (both wheels, 6 calibrations)
   MotorLine backward{0.0665, -0.070};
 
   // Duty to send for a wheel speed [rad/s, forward positive], polarity applied, clamped to [-1, 1];
@@ -49,7 +49,7 @@ struct MotorFitOptions {
   double loss_scale = 0.02;      // Cauchy loss scale, in duty units: residuals well beyond it (slips) barely count
   double max_abs_slope = 0.10;   // the reports' acceptance criterion
   double max_abs_punch = 0.10;
-  int min_samples = 5;           // per wheel and direction
+  int min_samples = 5;  // per wheel and direction
 };
 
 struct LineFit {
@@ -69,8 +69,8 @@ struct WheelFit {
 
 struct MotorFitReport {
   WheelFit left, right;
-  MotorCalibration calibration;  // the fitted lines with the configured polarities
-  bool acceptable = false;       // polarity right, both encoders counting, every line fitted within the limits
+  MotorCalibration calibration;       // the fitted lines with the configured polarities
+  bool acceptable = false;            // polarity right, both encoders counting, every line fitted within the limits
   std::vector<std::string> problems;  // why not acceptable, one line each, naming the wheel
 };
 

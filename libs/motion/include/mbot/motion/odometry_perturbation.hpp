@@ -12,8 +12,8 @@
 namespace mbot::motion {
 
 struct OdometryPerturbationOptions {
-  double noise_trans = 0.0;  // sigma of x and y per metre of each step
-  double noise_rot = 0.0;    // sigma of the heading per radian and metre of each step
+  double noise_trans = 0.0;   // sigma of x and y per metre of each step
+  double noise_rot = 0.0;     // sigma of the heading per radian and metre of each step
   double kidnap_at_s = -1.0;  // from this long after the first pose on, poses are offset (< 0: never)
   Pose2D kidnap_offset{1.0, 0.0, M_PI / 2};
 };

@@ -41,7 +41,7 @@ struct WheelControllerOptions {
 };
 
 struct WheelDuties {
-  double left = 0.0, right = 0.0;                          // duty as sent, in [-1, 1]
+  double left = 0.0, right = 0.0;                            // duty as sent, in [-1, 1]
   double left_target_rad_s = 0.0, right_target_rad_s = 0.0;  // the filtered wheel-speed targets
 };
 

@@ -10,9 +10,9 @@
 namespace mbot::motion {
 
 struct WheelOdometryOptions {
-  double left_m_per_tick = 0.0;   // signed: the polarity is in the sign
+  double left_m_per_tick = 0.0;  // signed: the polarity is in the sign
   double right_m_per_tick = 0.0;
-  double wheel_base_m = 0.0;      // distance between the wheels' contact points
+  double wheel_base_m = 0.0;  // distance between the wheels' contact points
 };
 
 // What the wheels say the robot did between two encoder readings.

@@ -57,11 +57,11 @@ struct PlanResult {
   // World poses from the start pose to the goal pose (headings along the path, the goal's heading
   // last); empty unless kFound. Start and goal in one cell give [start, goal].
   std::vector<motion::Pose2D> path;
-  double clearance_m = 0.0;   // the clearance requirement the returned path satisfies
-  double length_m = 0.0;      // length of the grid path (before pruning) in metres
-  double cost = 0.0;          // A* cost: length in cells plus penalties
-  int64_t expansions = 0;     // nodes expanded over every search of this query
-  int searches = 0;           // A* searches run (easing rungs actually searched)
+  double clearance_m = 0.0;  // the clearance requirement the returned path satisfies
+  double length_m = 0.0;     // length of the grid path (before pruning) in metres
+  double cost = 0.0;         // A* cost: length in cells plus penalties
+  int64_t expansions = 0;    // nodes expanded over every search of this query
+  int searches = 0;          // A* searches run (easing rungs actually searched)
 };
 
 // Plans on one distance grid. Setting the grid precomputes what every query shares (per-cell

@@ -20,15 +20,15 @@ struct ExplorationOptions {
   // Exploration keeps to mapped space: unknown cells count as obstacles for distances and paths.
   ObstacleDistanceOptions distance{/*unknown_is_obstacle=*/true};
   FrontierOptions frontier;
-  double home_tolerance_m = 0.03;      // completed when the robot is this close to home
-  double target_reached_m = 0.10;      // a frontier target counts as reached this close
+  double home_tolerance_m = 0.03;  // completed when the robot is this close to home
+  double target_reached_m = 0.10;  // a frontier target counts as reached this close
   // The map reaches the explorer some scans after the robot: a frontier counts as unresolved only
   // when it is still there this long after its target was reached.
   double resolve_wait_s = 1.0;
-  double blacklist_s = 30.0;           // how long an unreachable frontier is ignored (one still there
-                                       // resolve_wait_s after its target was reached is ignored for good)
-  double blacklist_radius_m = 0.30;    // frontiers whose centroid lies this close to a blacklisted one
-  double frontier_match_m = 0.50;      // the target frontier still exists if a frontier centroid is this close
+  double blacklist_s = 30.0;         // how long an unreachable frontier is ignored (one still there
+                                     // resolve_wait_s after its target was reached is ignored for good)
+  double blacklist_radius_m = 0.30;  // frontiers whose centroid lies this close to a blacklisted one
+  double frontier_match_m = 0.50;    // the target frontier still exists if a frontier centroid is this close
 };
 
 enum class ExplorationState { kInitializing, kExploring, kReturningHome, kCompleted, kFailed };
@@ -36,9 +36,9 @@ const char* ToString(ExplorationState state);
 
 struct ExplorationUpdate {
   ExplorationState state = ExplorationState::kInitializing;
-  bool new_path = false;                 // `path` replaces the previous one
-  std::vector<motion::Pose2D> path;      // the path to follow now (empty: stop)
-  std::string reason;                    // why the state or path changed (for logs and status)
+  bool new_path = false;             // `path` replaces the previous one
+  std::vector<motion::Pose2D> path;  // the path to follow now (empty: stop)
+  std::string reason;                // why the state or path changed (for logs and status)
 };
 
 class Explorer {
@@ -70,8 +70,8 @@ class Explorer {
   motion::Pose2D home_;
   std::vector<motion::Pose2D> path_;
   std::optional<motion::Pose2D> target_frontier_;  // centroid of the frontier being explored
-  int target_size_ = 0;       // its size in cells when it was chosen
-  double reached_at_s_ = -1;  // when the robot reached the target of the frontier being explored
+  int target_size_ = 0;                            // its size in cells when it was chosen
+  double reached_at_s_ = -1;                       // when the robot reached the target of the frontier being explored
   std::vector<Blacklisted> blacklist_;
   std::vector<Frontier> frontiers_;
   std::string failure_reason_;

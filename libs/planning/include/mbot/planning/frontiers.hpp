@@ -11,13 +11,13 @@
 namespace mbot::planning {
 
 struct FrontierOptions {
-  int min_cells = 5;               // regions with fewer frontier cells are ignored
-  double search_radius_m = 1.0;    // radial search around a centroid for a reachable free cell
+  int min_cells = 5;             // regions with fewer frontier cells are ignored
+  double search_radius_m = 1.0;  // radial search around a centroid for a reachable free cell
 };
 
 struct Frontier {
-  std::vector<int> cells;          // row-major cell indices of the map
-  double centroid_x = 0.0;         // world frame [m]
+  std::vector<int> cells;   // row-major cell indices of the map
+  double centroid_x = 0.0;  // world frame [m]
   double centroid_y = 0.0;
   int size() const { return static_cast<int>(cells.size()); }
 };
@@ -27,9 +27,9 @@ struct Frontier {
 std::vector<Frontier> FindFrontiers(const mapping::OccupancyGrid& map, const FrontierOptions& options);
 
 struct FrontierGoal {
-  int frontier = -1;               // index into the frontier list
-  motion::Pose2D target;           // the reachable cell chosen for it
-  double cost = 0.0;               // path cost from the robot (planner cost model)
+  int frontier = -1;      // index into the frontier list
+  motion::Pose2D target;  // the reachable cell chosen for it
+  double cost = 0.0;      // path cost from the robot (planner cost model)
 };
 
 // For each frontier, the cell the robot can reach: its centroid when that cell is reachable,

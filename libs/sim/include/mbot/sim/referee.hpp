@@ -28,8 +28,8 @@ const char* Title(CompetitionEvent event);     // "Speed Run" …
 
 struct RefereeOptions {
   CompetitionEvent event = CompetitionEvent::kSpeedRun;
-  double time_limit_s = 180.0;   // the run ends here if the mission has not
-  double finish_delay_s = 0.5;   // keep simulating this long after the mission ends (the robot stops)
+  double time_limit_s = 180.0;  // the run ends here if the mission has not
+  double finish_delay_s = 0.5;  // keep simulating this long after the mission ends (the robot stops)
 };
 
 // One line of the rubric: what was judged, how it went, the points.
@@ -61,11 +61,11 @@ struct Score {
   bool scored = false;     // false without ground truth (nothing to judge)
   bool completed = false;  // the mission said completed
   bool timed_out = false;
-  double time_s = 0;       // to the mission's end, or the whole run
-  double sim_s = 0;        // simulated time seen
+  double time_s = 0;  // to the mission's end, or the whole run
+  double sim_s = 0;   // simulated time seen
   int collisions = 0;
-  motion::Pose2D start, final_pose;  // true, world frame
-  motion::Pose2D map_frame;          // where the map frame lies in the world
+  motion::Pose2D start, final_pose;           // true, world frame
+  motion::Pose2D map_frame;                   // where the map frame lies in the world
   std::optional<PoseError> final_error;       // final pose against the start (not the Warehouse)
   std::optional<PoseError> slam_final_error;  // SLAM's last pose against the truth then
   std::optional<MapQuality> map;              // not the Warehouse

@@ -53,13 +53,13 @@ inline constexpr const char* kCollision = "SIM_COLLISION";
 }  // namespace sim_channel
 
 struct SimLidarOptions {
-  double rate_hz = 8.0;          // revolutions per second
-  int beams = 360;               // per revolution
+  double rate_hz = 8.0;  // revolutions per second
+  int beams = 360;       // per revolution
   double max_range_m = 12.0;
-  double min_range_m = 0.15;     // closer returns are dropped, as the RPLidar's
-  double range_noise_m = 0.01;   // standard deviation
-  double dropout = 0.01;         // probability that a beam gives no return
-  motion::Pose2D mount;          // sensor pose on the robot
+  double min_range_m = 0.15;    // closer returns are dropped, as the RPLidar's
+  double range_noise_m = 0.01;  // standard deviation
+  double dropout = 0.01;        // probability that a beam gives no return
+  motion::Pose2D mount;         // sensor pose on the robot
   // The RPLidar spins clockwise: beam angles (counter-clockwise convention) go 0, −step, −2·step …
   // in time, as a real log's decoded angles do. false: 0, +step, … .
   bool clockwise = true;
@@ -73,16 +73,16 @@ struct SimImuOptions {
 };
 
 struct SimRobotOptions {
-  motion::RobotGeometry geometry;                // classic MBot; its encoder polarities sign the ticks
-  motion::MotorCalibration motors;               // the true motors (steady-state duty ↔ speed)
-  double left_motor_gain = 1.0;                  // per-wheel differences: true speed scale
+  motion::RobotGeometry geometry;   // classic MBot; its encoder polarities sign the ticks
+  motion::MotorCalibration motors;  // the true motors (steady-state duty ↔ speed)
+  double left_motor_gain = 1.0;     // per-wheel differences: true speed scale
   double right_motor_gain = 0.96;
-  double motor_time_constant_s = 0.05;           // wheel speed follows its steady state with this lag
-  motion::MotorCalibration firmware_calibration; // what the firmware's feed-forward believes
-  motion::WheelControllerOptions controller;     // firmware wheel-speed controller (its dt is the firmware period)
-  motion::GyrodometryOptions firmware_odometry;  // how the firmware fuses its gyro
-  double slip_stddev = 0.02;                     // relative ground-speed noise of each wheel (slip)
-  double slip_interval_s = 0.05;                 // the slip of each wheel is redrawn this often (not white)
+  double motor_time_constant_s = 0.05;            // wheel speed follows its steady state with this lag
+  motion::MotorCalibration firmware_calibration;  // what the firmware's feed-forward believes
+  motion::WheelControllerOptions controller;      // firmware wheel-speed controller (its dt is the firmware period)
+  motion::GyrodometryOptions firmware_odometry;   // how the firmware fuses its gyro
+  double slip_stddev = 0.02;                      // relative ground-speed noise of each wheel (slip)
+  double slip_interval_s = 0.05;                  // the slip of each wheel is redrawn this often (not white)
   double physics_dt_s = 0.002;
   // A contact ends (and the next one counts again) once the footprint grown by this much is clear.
   double contact_release_m = 0.01;
@@ -107,7 +107,7 @@ class SimRobot {
 
   int64_t now_us() const;
   const motion::Pose2D& true_pose() const;
-  int collisions() const;   // contacts begun so far
+  int collisions() const;  // contacts begun so far
   bool in_contact() const;
   double distance_travelled_m() const;
   // True wheel rotational speeds [rad/s, forward positive] (0 while stalled against a wall).
