@@ -10,6 +10,7 @@ packages=(
   libopencv-dev libeigen3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   zlib1g-dev
+  clang-format  # scripts/check_format.sh (ctest format.check)
   iproute2    # the live LCM tests set up loopback multicast in a private network namespace
 )
 

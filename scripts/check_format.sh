@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Checks that every tracked C++ file is formatted with the project's .clang-format (exit 1 and the
+# offending files otherwise). Fix with: clang-format -i $(git ls-files '*.cpp' '*.hpp')
+set -uo pipefail
+cd "$(dirname "$0")/.."
+command -v clang-format > /dev/null || { echo "SKIPPED: clang-format is not installed (scripts/install_deps.sh installs it)"; exit 77; }
+if git rev-parse --git-dir > /dev/null 2>&1; then
+  files=$(git ls-files '*.cpp' '*.hpp')
+else
+  files=$(find apps libs tests -name '*.cpp' -o -name '*.hpp')
+fi
+bad=()
+for f in $files; do
+  clang-format --dry-run -Werror "$f" > /dev/null 2>&1 || bad+=("$f")
+done
+if [ ${#bad[@]} -gt 0 ]; then
+  echo "not formatted with .clang-format (${#bad[@]} files):"
+  printf '  %s\n' "${bad[@]}"
+  exit 1
+fi
+echo "format: $(echo "$files" | wc -w) files formatted"
