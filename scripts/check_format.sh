@@ -9,13 +9,10 @@ if git rev-parse --git-dir > /dev/null 2>&1; then
 else
   files=$(find apps libs tests -name '*.cpp' -o -name '*.hpp')
 fi
-bad=()
-for f in $files; do
-  clang-format --dry-run -Werror "$f" > /dev/null 2>&1 || bad+=("$f")
-done
-if [ ${#bad[@]} -gt 0 ]; then
-  echo "not formatted with .clang-format (${#bad[@]} files):"
-  printf '  %s\n' "${bad[@]}"
+# One clang-format for all files; its warnings name each file that differs.
+if ! out=$(clang-format --dry-run -Werror $files 2>&1); then
+  echo "not formatted with .clang-format:"
+  echo "$out" | sed -n 's/^\([^:]*\):[0-9]*:[0-9]*: error:.*/  \1/p' | sort -u
   exit 1
 fi
 echo "format: $(echo "$files" | wc -w) files formatted"
