@@ -4,6 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include "maebot/maebot_encoders_t.hpp"
+#include "maebot/maebot_motor_command_t.hpp"
+#include "mbot_legacy/mbot_encoder_t.hpp"
+#include "mbot_legacy/mbot_imu_t.hpp"
+#include "mbot_legacy/mbot_motor_command_t.hpp"
+#include "mbot_legacy/pose_xyt_t.hpp"
+#include "mbot_w23/mbot_wheel_ctrl_t.hpp"
+
 namespace mbot::drivers {
 namespace {
 
@@ -77,6 +85,71 @@ TEST(LcmMessages, OdometryPoseRoundTrips) {
   EXPECT_FLOAT_EQ(p.x, 1.5f);
   EXPECT_FLOAT_EQ(p.y, -2.0f);
   EXPECT_FLOAT_EQ(p.theta, 0.75f);
+}
+
+Event DecodeBytes(const std::string& channel, const std::vector<uint8_t>& bytes) {
+  const ChannelRoles roles;
+  Event out;
+  out.channel = channel;
+  std::string error;
+  const bool ok = lcm_adapter::Decode(channel, bytes.data(), bytes.size(), roles, &out, &error);
+  EXPECT_TRUE(ok) << error;
+  return out;
+}
+
+// The older generations (decoded only: the stack publishes the current types) — each message as
+// its own generation's code writes it comes in as the typed event.
+template <typename Msg>
+Event DecodeOld(const std::string& channel, const Msg& m) {
+  std::vector<uint8_t> bytes(m.getEncodedSize());
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return DecodeBytes(channel, bytes);
+}
+
+TEST(LcmMessages, LegacyGenerationDecodes) {
+  mbot_legacy::mbot_encoder_t enc{};
+  enc.utime = 10, enc.leftticks = 100, enc.rightticks = -50, enc.left_delta = 3, enc.right_delta = -2;
+  const Event e = DecodeOld("MBOT_ENCODERS", enc);
+  ASSERT_EQ(e.kind, EventKind::kEncoders);
+  EXPECT_EQ(std::get<EncoderTicks>(e.payload).left_ticks, 100);
+  EXPECT_EQ(std::get<EncoderTicks>(e.payload).right_delta, -2);
+  mbot_legacy::mbot_imu_t imu{};
+  imu.utime = 11, imu.gyro[2] = 0.5f, imu.tb_angles[2] = 1.25f;
+  const Event i = DecodeOld("MBOT_IMU", imu);
+  ASSERT_EQ(i.kind, EventKind::kImu);
+  EXPECT_FLOAT_EQ(std::get<Imu>(i.payload).gyro_rad_s[2], 0.5f);
+  EXPECT_FLOAT_EQ(std::get<Imu>(i.payload).angles_rpy_rad[2], 1.25f);
+  mbot_legacy::mbot_motor_command_t cmd{};
+  cmd.utime = 12, cmd.trans_v = 0.2f, cmd.angular_v = -0.4f;
+  const Event c = DecodeOld("MBOT_MOTOR_COMMAND", cmd);
+  ASSERT_EQ(c.kind, EventKind::kMotorCommand);
+  EXPECT_FLOAT_EQ(std::get<MotorCommand>(c.payload).velocity.w_rad_s, -0.4f);
+  mbot_legacy::pose_xyt_t pose{};
+  pose.utime = 13, pose.x = 1.5f, pose.y = 2.5f, pose.theta = 0.5f;
+  const Event p = DecodeOld("TRUE_POSE", pose);
+  ASSERT_EQ(p.kind, EventKind::kGroundTruth);
+  EXPECT_FLOAT_EQ(std::get<motion::Pose2D>(p.payload).y, 2.5f);
+}
+
+TEST(LcmMessages, Winter2023AndMaebotGenerationsDecode) {
+  mbot_w23::mbot_wheel_ctrl_t w{};
+  w.utime = 20, w.left_motor_pwm = 0.3f, w.right_motor_pwm = -0.1f;
+  const Event c = DecodeOld("MBOT_WHEEL_CTRL", w);
+  ASSERT_EQ(c.kind, EventKind::kMotorCommand);
+  EXPECT_EQ(std::get<MotorCommand>(c.payload).kind, MotorCommand::Kind::kPwm);
+  EXPECT_FLOAT_EQ(std::get<MotorCommand>(c.payload).right_duty, -0.1f);
+  maebot::maebot_encoders_t enc{};
+  enc.utime = 21, enc.left_ticks_total = 7, enc.right_ticks_total = 9;
+  const Event e = DecodeOld("MAEBOT_ENCODERS", enc);
+  ASSERT_EQ(e.kind, EventKind::kEncoders);
+  EXPECT_EQ(std::get<EncoderTicks>(e.payload).right_ticks, 9);
+  maebot::maebot_motor_command_t m{};
+  m.utime = 22, m.left_motor_speed = 0.5f, m.right_motor_speed = 0.7f, m.left_motor_enabled = true,
+  m.right_motor_enabled = false;
+  const Event d = DecodeOld("MAEBOT_MOTOR_COMMAND", m);
+  ASSERT_EQ(d.kind, EventKind::kMotorCommand);
+  EXPECT_FLOAT_EQ(std::get<MotorCommand>(d.payload).left_duty, 0.5f);
+  EXPECT_EQ(std::get<MotorCommand>(d.payload).right_duty, 0.0);  // disabled
 }
 
 }  // namespace

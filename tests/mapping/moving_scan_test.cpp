@@ -69,3 +69,36 @@ TEST(SlamEventTracker, ConvergenceLostAndRecovered) {
 
 }  // namespace
 }  // namespace mbot::mapping
+
+namespace mbot::mapping {
+namespace {
+
+// A robot turning on the spot at 1 rad per scan: each beam is rotated by the turn left to go
+// after it was measured, so the rays come out in the frame of the pose at the scan's end.
+TEST(DeskewScan, RaysLandInTheFrameOfTheScansEnd) {
+  const std::vector<float> ranges = {1.0f, 1.0f, 1.0f};
+  const std::vector<float> angles = {0.0f, 0.0f, 0.0f};
+  const std::vector<float> fractions = {0.0f, 0.5f, 1.0f};
+  const motion::Pose2D start_in_end{0, 0, -1.0};  // the robot turned +1 rad during the scan
+  ScanOptions o;
+  const std::vector<ScanRay> rays = DeskewScan(ranges, angles, fractions, start_in_end, {}, 0.0, o);
+  ASSERT_EQ(rays.size(), 3u);
+  EXPECT_NEAR(std::atan2(rays[0].ey, rays[0].ex), -1.0, 1e-5);
+  EXPECT_NEAR(std::atan2(rays[1].ey, rays[1].ex), -0.5, 1e-5);
+  EXPECT_NEAR(std::atan2(rays[2].ey, rays[2].ex), 0.0, 1e-5);
+  for (const ScanRay& r : rays) EXPECT_NEAR(std::hypot(r.ex - r.ox, r.ey - r.oy), 1.0, 1e-5);
+}
+
+TEST(DeskewScan, ShortAndMissingReturnsClearNothingOrAreMisses) {
+  ScanOptions o;
+  o.min_range_m = 0.1;
+  o.max_range_m = 5.0;
+  const std::vector<ScanRay> rays = DeskewScan({0.05f, 6.0f, 2.0f, -1.0f}, {0, 0, 0, 0}, {}, {}, {}, 0.0, o);
+  int hits = 0, misses = 0;
+  for (const ScanRay& r : rays) (r.hit ? hits : misses)++;
+  EXPECT_EQ(hits, 1);    // 2.0 m
+  EXPECT_LE(misses, 1);  // 6.0 m beyond max_range_m clears as a miss; too short and no return are dropped
+}
+
+}  // namespace
+}  // namespace mbot::mapping
