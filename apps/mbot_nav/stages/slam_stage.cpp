@@ -6,8 +6,6 @@
 // the map, the trajectories and metrics.json.
 #include <chrono>
 #include <cmath>
-#include <deque>
-#include <map>
 #include <optional>
 
 #include "mbot/common/config.hpp"
@@ -15,10 +13,9 @@
 #include "mbot/drivers/map_io.hpp"
 #include "mbot/mapping/moving_scan.hpp"
 #include "mbot/mapping/slam.hpp"
-#include "mbot/motion/odometry_perturbation.hpp"
-#include "mbot/motion/wheel_odometry.hpp"
 #include "report.hpp"
 #include "slam_config.hpp"
+#include "slam_inputs.hpp"
 #include "slam_outputs.hpp"
 #include "stages.hpp"
 
@@ -37,136 +34,44 @@ class SlamStage : public Stage {
   void Start(const RunContext& ctx) override {
     bus_ = ctx.bus;
     slam_ = mapping::Slam(options_.slam, ctx.seed);
-    perturbation_.emplace(options_.perturbation, ctx.seed);
+    inputs_.emplace(options_, ctx.seed);
     if (!options_.map_file.empty()) {
       std::string format;
       slam_.SetMap(drivers::ReadAnyMap(options_.map_file, &format));
       mbot::log::Info("slam: known map " + options_.map_file + " (" + format + ", " +
                       std::to_string(slam_.map().width()) + "x" + std::to_string(slam_.map().height()) + ")");
     }
-    if (options_.encoder_odometry) wheel_odometry_.emplace(options_.wheels);
     consistency_model_ = mapping::SensorModel(options_.slam.sensor);
     wall_start_ = std::chrono::steady_clock::now();
   }
 
   void OnEvent(const drivers::Event& in) override {
-    if (first_t_us_ < 0) first_t_us_ = in.t_us;
-    last_t_us_ = in.t_us;
-    drivers::Event retimed;
-    const drivers::Event& ev = Retime(in, &retimed);
-    switch (ev.kind) {
-      case EventKind::kOdometry:
-        if (!options_.encoder_odometry && Accept(&odometry_channel_, options_.odometry_channel, ev)) {
-          AddOdometry(ev.t_us, std::get<Pose2D>(ev.payload));
-        }
-        break;
-      case EventKind::kEncoders:
-        if (options_.encoder_odometry && Accept(&encoder_channel_, "", ev)) {
-          const auto& e = std::get<drivers::EncoderTicks>(ev.payload);
-          AddOdometry(ev.t_us, wheel_odometry_->Update(e.left_ticks, e.right_ticks));
-        }
-        break;
-      case EventKind::kGroundTruth:
-        if (Accept(&truth_channel_, options_.ground_truth_channel, ev)) Append(&ground_truth_, ev);
-        break;
-      case EventKind::kReferencePose:
-        if (Accept(&reference_channel_, options_.reference_channel, ev)) Append(&reference_, ev);
-        break;
-      case EventKind::kLidar:
-        if (Accept(&lidar_channel_, options_.lidar_channel, ev)) {
-          // How late the scan arrived: its stamp is the robot's clock, its event time the logger's.
-          const int64_t latency = std::llabs(in.t_us - in.stamp_us) < 2'000'000 ? in.t_us - in.stamp_us : 0;
-          pending_.push_back(Pending{ev.t_us, previous_scan_us_, latency, std::get<drivers::LidarScan>(ev.payload)});
-          previous_scan_us_ = ev.t_us;
-        }
-        break;
-      default: return;
-    }
-    ProcessReadyScans(false);
+    if (inputs_->Add(in)) ProcessReadyScans(false);
   }
 
   void Finish(const RunContext& ctx, bool interrupted) override {
     ProcessReadyScans(true);
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
     if (records_.empty()) {
-      mbot::log::Warn("slam: no scan was processed (lidar channel '" + lidar_channel_ + "', " +
+      mbot::log::Warn("slam: no scan was processed (lidar channel '" + inputs_->lidar_channel() + "', " +
                       std::to_string(skipped_scans_) + " scans without poses); no outputs written");
       return;
     }
     WriteSlamOutputs(ctx, interrupted,
-                     SlamRun{&options_, &slam_, &records_, &ground_truth_, &reference_, &events_, &scan_points_,
-                             &particle_snapshots_, first_t_us_, last_t_us_, perturbation_->kidnapped_at_us(),
-                             skipped_scans_, wall_s});
+                     SlamRun{&options_, &slam_, &records_, &inputs_->ground_truth(), &inputs_->reference(), &events_,
+                             &scan_points_, &particle_snapshots_, inputs_->first_t_us(), inputs_->last_t_us(),
+                             inputs_->kidnapped_at_us(), skipped_scans_, wall_s});
   }
 
  private:
-  struct Pending {
-    int64_t t_us;
-    int64_t previous_us;  // the scan before, or -1
-    int64_t latency_us;   // arrival time − stamp when both share a clock, else 0
-    drivers::LidarScan scan;
-  };
-
-  // The time each message is placed at: its own stamp when the channel's stamps share the log's
-  // clock (the robot's measurement time, immune to network bursts), else its arrival time.
-  const drivers::Event& Retime(const drivers::Event& ev, drivers::Event* copy) {
-    if (options_.time_base == "event" || ev.stamp_us == 0) return ev;
-    auto it = stamp_channels_.find(ev.channel);
-    if (it == stamp_channels_.end()) {
-      const bool same_clock = options_.time_base == "stamp" || std::llabs(ev.stamp_us - ev.t_us) < 2'000'000;
-      it = stamp_channels_.emplace(ev.channel, same_clock).first;
-      if (!same_clock) mbot::log::Info("slam: " + ev.channel + " stamps use another clock; using arrival times");
-    }
-    if (!it->second) return ev;
-    if (ev.kind != EventKind::kLidar && ev.kind != EventKind::kOdometry && ev.kind != EventKind::kEncoders &&
-        ev.kind != EventKind::kGroundTruth && ev.kind != EventKind::kReferencePose) {
-      return ev;
-    }
-    *copy = ev;
-    copy->t_us = ev.stamp_us;
-    return *copy;
-  }
-
-  // Takes the first channel of a kind unless the options name one.
-  bool Accept(std::string* chosen, const std::string& wanted, const drivers::Event& ev) {
-    if (!wanted.empty()) return ev.channel == wanted;
-    if (chosen->empty()) *chosen = ev.channel;
-    if (*chosen == ev.channel) return true;
-    mbot::log::WarnOnce("slam:" + ev.channel, "slam: " + std::string(drivers::ToString(ev.kind)) + " channel " +
-                                                  ev.channel + " ignored; using " + *chosen);
-    return false;
-  }
-
-  static void Append(std::vector<TimedPose>* series, const drivers::Event& ev) {
-    if (!series->empty() && ev.t_us < series->back().t_us) return;
-    series->push_back({ev.t_us, std::get<Pose2D>(ev.payload)});
-  }
-
-  // Odometry as the filter sees it: with the configured perturbations (noise, a kidnapping jump).
-  void AddOdometry(int64_t t_us, const Pose2D& raw) {
-    const Pose2D out = perturbation_->Apply(t_us, first_t_us_, raw);
-    if (!odometry_.empty() && t_us < odometry_.back().t_us) return;
-    odometry_.push_back({t_us, out});
-  }
-
-  const std::vector<TimedPose>& PoseSource() const {
-    return options_.slam.mode == mapping::SlamMode::kMappingOnly
-               ? (options_.mapping_poses_from_reference ? reference_ : ground_truth_)
-               : odometry_;
-  }
-
   void ProcessReadyScans(bool at_end) {
-    const std::vector<TimedPose>& poses = PoseSource();
-    while (!pending_.empty()) {
-      Pending& p = pending_.front();
-      const int64_t t_end = p.t_us + options_.lidar_time_offset_us;
-      if (!at_end && (poses.empty() || poses.back().t_us < t_end)) return;  // wait for the poses to catch up
-      ProcessScan(p, t_end, poses);
-      pending_.pop_front();
+    while (const SlamInputs::Scan* p = inputs_->ReadyScan(at_end)) {
+      ProcessScan(*p, p->t_us + options_.lidar_time_offset_us, inputs_->poses());
+      inputs_->PopScan();
     }
   }
 
-  void ProcessScan(const Pending& p, int64_t t_end, const std::vector<TimedPose>& poses) {
+  void ProcessScan(const SlamInputs::Scan& p, int64_t t_end, const std::vector<TimedPose>& poses) {
     const drivers::LidarScan& scan = p.scan;
     // When was each beam measured, as a fraction of the scan's duration?
     const mapping::BeamTimes beams = mapping::TimeBeams(options_.beam_timing, scan.angles_rad, scan.beam_times_us,
@@ -206,7 +111,7 @@ class SlamStage : public Stage {
     r.update_ms = ms;
     r.latency_us = p.latency_us;
     Pose2D odo;
-    r.odometry = motion::InterpolateAt(odometry_, t_end, max_gap, &odo) ? odo : end_pose;
+    r.odometry = motion::InterpolateAt(inputs_->odometry(), t_end, max_gap, &odo) ? odo : end_pose;
     records_.push_back(r);
     Publish(r);
     if (options_.particles_every > 0 && !mapping_only && records_.size() % options_.particles_every == 1) {
@@ -252,7 +157,7 @@ class SlamStage : public Stage {
       return true;
     }
     if (options_.initial == "ground_truth" || options_.initial == "reference") {
-      const auto& series = options_.initial == "ground_truth" ? ground_truth_ : reference_;
+      const auto& series = options_.initial == "ground_truth" ? inputs_->ground_truth() : inputs_->reference();
       if (!motion::InterpolateAt(series, t_us, max_gap, &start)) {
         // The series may not have reached this scan yet: take its latest pose if it is recent.
         if (series.empty() || std::llabs(series.back().t_us - t_us) > max_gap) return false;
@@ -267,23 +172,16 @@ class SlamStage : public Stage {
 
   // Global-localization convergence and kidnapping: when lost was flagged, when the filter recovered.
   void TrackEvents(const ScanRecord& r) {
-    const std::string said =
-        events_.Add((r.t_us - first_t_us_) * 1e-6, static_cast<int>(records_.size()) - 1, r.updated, r.status);
+    const std::string said = events_.Add((r.t_us - inputs_->first_t_us()) * 1e-6, static_cast<int>(records_.size()) - 1,
+                                         r.updated, r.status);
     if (!said.empty()) mbot::log::Info("slam: " + said);
   }
 
   SlamStageOptions options_;
   mapping::Slam slam_;
   mapping::SlamEventTracker events_;
-  std::optional<motion::OdometryPerturbation> perturbation_;
+  std::optional<SlamInputs> inputs_;
   Bus* bus_ = nullptr;
-  std::optional<motion::WheelOdometry> wheel_odometry_;
-  std::string odometry_channel_, encoder_channel_, truth_channel_, reference_channel_, lidar_channel_;
-  std::vector<TimedPose> odometry_, ground_truth_, reference_;
-  std::deque<Pending> pending_;
-  std::map<std::string, bool> stamp_channels_;  // channel → its stamps share the log's clock
-  int64_t previous_scan_us_ = -1;
-  int64_t first_t_us_ = -1, last_t_us_ = -1;
   std::optional<mapping::SlamState> published_state_;
   int skipped_scans_ = 0;
   std::vector<ScanRecord> records_;
