@@ -126,4 +126,36 @@ MotorFitReport FitMotorCalibration(const std::vector<MotorSample>& left, const s
   return r;
 }
 
+void SettledMotorSamples::OnDuty(int64_t t, double left, double right) {
+  const double d[2] = {left, right};
+  for (int w = 0; w < 2; ++w) {
+    if (!duty_known_[w] || std::abs(d[w] - duty_[w]) > duty_tolerance_) duty_since_[w] = t;
+    duty_[w] = d[w];
+    duty_known_[w] = true;
+  }
+}
+
+void SettledMotorSamples::OnWheelSpeeds(int64_t t, double left, double right) { Add(t, left, right, measured_); }
+
+void SettledMotorSamples::OnEncoderTicks(int64_t t, int64_t left, int64_t right, int64_t delta_time_us) {
+  if (have_ticks_) {
+    const double dt = delta_time_us > 0 ? delta_time_us * 1e-6 : (t - ticks_t_) * 1e-6;
+    if (dt > 0) {
+      const double k = rad_per_tick_ / dt;
+      Add(t, k * (left - left_ticks_), k * (right - right_ticks_), from_encoders_);
+    }
+  }
+  have_ticks_ = true;
+  ticks_t_ = t, left_ticks_ = left, right_ticks_ = right;
+}
+
+void SettledMotorSamples::Add(int64_t t, double left_speed, double right_speed, std::vector<MotorSample>* out) {
+  const double s[2] = {left_speed, right_speed};
+  for (int w = 0; w < 2; ++w) {
+    if (!duty_known_[w] || !std::isfinite(s[w])) continue;
+    if ((t - duty_since_[w]) * 1e-6 < settle_s_) continue;
+    out[w].push_back({duty_[w], s[w]});
+  }
+}
+
 }  // namespace mbot::motion

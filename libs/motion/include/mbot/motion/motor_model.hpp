@@ -7,6 +7,7 @@
 #pragma once
 
 #include <string>
+#include <cstdint>
 #include <vector>
 
 namespace mbot::motion {
@@ -39,6 +40,33 @@ struct MotorCalibration {
 struct MotorSample {
   double duty = 0.0;
   double speed_rad_s = 0.0;
+};
+
+// Calibration samples from a log of a calibration run: each wheel's PWM duty paired with the wheel
+// speed measured while that duty had held (within `duty_tolerance`) for at least `settle_s` — from
+// the measured wheel speeds, and, separately, from speeds derived from encoder ticks.
+class SettledMotorSamples {
+ public:
+  SettledMotorSamples(double settle_s, double duty_tolerance, double rad_per_tick)
+      : settle_s_(settle_s), duty_tolerance_(duty_tolerance), rad_per_tick_(rad_per_tick) {}
+  void OnDuty(int64_t t_us, double left, double right);
+  void OnWheelSpeeds(int64_t t_us, double left_rad_s, double right_rad_s);
+  // Cumulative ticks; `delta_time_us` when the message says how long since the previous (else 0).
+  void OnEncoderTicks(int64_t t_us, int64_t left_ticks, int64_t right_ticks, int64_t delta_time_us);
+  // Per wheel (0 left, 1 right), raw signs.
+  const std::vector<MotorSample>* measured() const { return measured_; }
+  const std::vector<MotorSample>* from_encoders() const { return from_encoders_; }
+
+ private:
+  void Add(int64_t t_us, double left_speed, double right_speed, std::vector<MotorSample>* out);
+
+  double settle_s_, duty_tolerance_, rad_per_tick_;
+  std::vector<MotorSample> measured_[2], from_encoders_[2];
+  double duty_[2] = {0, 0};
+  bool duty_known_[2] = {false, false};
+  int64_t duty_since_[2] = {0, 0};
+  bool have_ticks_ = false;
+  int64_t ticks_t_ = 0, left_ticks_ = 0, right_ticks_ = 0;
 };
 
 struct MotorFitOptions {
