@@ -42,10 +42,19 @@ void HandOutInputs(const std::string& world_path, const std::string& dir, config
   const sim::EventInputs in = sim::EventInputsOf(world);
   config::Section mission = event->GetSection("mission");
   const std::string task = mission.Has("task") ? mission.GetString("task", "", "") : "";
-  if (task == "waypoints" && !in.waypoints.empty()) event->Set("mission.waypoints=" + PosesText(in.waypoints));
+  if (task == "waypoints") {
+    if (in.waypoints.empty()) {
+      throw config::ConfigError(world_path + " has no 'pose start' and 'pose waypoint' lines: no circuit to hand out");
+    }
+    event->Set("mission.waypoints=" + PosesText(in.waypoints));
+  }
   if (task == "warehouse") {
-    if (!in.targets.empty()) event->Set("mission.targets=" + PosesText(in.targets));
-    if (!in.dropoffs.empty()) event->Set("mission.dropoffs=" + PosesText(in.dropoffs));
+    if (in.targets.empty() || in.dropoffs.empty()) {
+      throw config::ConfigError(world_path +
+                                " has no 'pose target' and 'pose dropoff' lines: no Warehouse to hand out");
+    }
+    event->Set("mission.targets=" + PosesText(in.targets));
+    event->Set("mission.dropoffs=" + PosesText(in.dropoffs));
   }
   config::Section slam = event->GetSection("slam");
   if (slam.Has("mode") && slam.GetString("mode", "", "") == "localization") {
@@ -119,13 +128,20 @@ CompetitionPlan BuildCompetition(const config::Config& config) {
       event.Set("pipeline.seed=" + std::to_string(event_seed));
       event.Set("pipeline.progress=off");  // the events are short; the table is the report
       event.Set("output.dir=" + plan.output_dir + "/" + name);
-      if (!world.empty()) {
-        event.Set("source.path=" + world);
-        HandOutInputs(world, plan.output_dir + "/" + name, &event);
-      }
+      if (!world.empty()) event.Set("source.path=" + world);
       for (const std::string& s : sets) event.Set(s);
     } catch (const config::ConfigError& err) {
       e.Fail("set", err.what());
+    }
+    if (!world.empty()) {
+      // The world's inputs, handed out with the event's own settings (its task, SLAM's resolution);
+      // an explicit `set` of the same keys still wins.
+      try {
+        HandOutInputs(world, plan.output_dir + "/" + name, &event);
+        for (const std::string& s : sets) event.Set(s);
+      } catch (const std::exception& err) {
+        e.Fail("world", err.what());
+      }
     }
     try {
       plan.events.push_back({name, BuildPlan(event)});

@@ -40,6 +40,9 @@ struct RunContext {
   // A stage's headline results (key, value), added in Finish, returned in RunSummary::results: what a
   // caller running several pipelines (the competition) gathers into one table. Valid in Finish.
   std::vector<std::pair<std::string, std::string>>* results = nullptr;
+  // Where emitted events end up after the later stages (the simulator, live LCM), or nullptr on a
+  // recorded dataset; the bus already forwards to it, so stages read it only to know there is one.
+  drivers::Sink* sink = nullptr;
 };
 
 class Stage {

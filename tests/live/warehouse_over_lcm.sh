@@ -19,7 +19,7 @@ export bin config out deliveries seed
 unshare -n bash -c '
   set -u
   ip link set lo up && ip route add 224.0.0.0/4 dev lo || { echo "cannot set up loopback multicast"; exit 1; }
-  "$bin" --config "$config/live_warehouse.ini" --set output.dir="$out/autonomy" --set source.end_after_silence_s=3 \
+  "$bin" --config "$config/live_warehouse.ini" --set output.dir="$out/autonomy" --set source.end_after_silence_s=5 \
     --set pipeline.seed=$seed --set mission.deliveries=$deliveries --set pipeline.progress=off > "$out/autonomy.log" 2>&1 &
   autonomy=$!
   sleep 1  # the autonomy listens before the robot starts publishing

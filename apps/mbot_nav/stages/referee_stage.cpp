@@ -75,9 +75,10 @@ class RefereeStage : public Stage {
 
   void Start(const RunContext& ctx) override {
     bus_ = ctx.bus;
+    sim::World world = sim::World::Load(ctx.source_path);
     try {
-      referee_ = std::make_unique<sim::Referee>(o_.referee, sim::World::Load(ctx.source_path), ctx.seed);
-    } catch (const std::invalid_argument& e) {
+      referee_ = std::make_unique<sim::Referee>(o_.referee, std::move(world), ctx.seed);
+    } catch (const std::invalid_argument& e) {  // only a Warehouse needs more than walls
       throw std::runtime_error("referee: the world " + ctx.source_path +
                                " has no Warehouse ('pose target' and 'pose dropoff' lines): " + e.what());
     }

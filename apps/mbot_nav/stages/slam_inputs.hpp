@@ -28,7 +28,10 @@ class SlamInputs {
     drivers::LidarScan scan;
   };
 
+  // Keeps a reference to `options`, which must outlive it.
   SlamInputs(const SlamStageOptions& options, uint64_t seed);
+  SlamInputs(const SlamInputs&) = delete;
+  SlamInputs& operator=(const SlamInputs&) = delete;
 
   // Takes one event of the stream; false when it is of no interest to SLAM.
   bool Add(const drivers::Event& in);

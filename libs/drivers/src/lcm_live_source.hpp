@@ -25,6 +25,7 @@ namespace mbot::drivers {
 
 class LcmLiveSource : public Source, public Sink {
  public:
+  Sink* sink() override { return this; }
   explicit LcmLiveSource(const SourceOptions& options);
 
   // The next message, or a heartbeat (kOther on channel LIVE_TICK) after 50 ms without one, so the

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <algorithm>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -123,8 +124,12 @@ std::vector<SourceType> BuiltInTypes() {
   return t;
 }
 
-std::vector<SourceType>& Registry() {
-  static std::vector<SourceType> types = BuiltInTypes();
+// A deque: registering a type never moves the ones before it (FindSourceType's pointers stay valid).
+std::deque<SourceType>& Registry() {
+  static std::deque<SourceType> types = [] {
+    std::vector<SourceType> v = BuiltInTypes();
+    return std::deque<SourceType>(v.begin(), v.end());
+  }();
   return types;
 }
 
@@ -135,7 +140,7 @@ void RegisterSourceType(SourceType type) {
   Registry().push_back(std::move(type));
 }
 
-const std::vector<SourceType>& SourceTypes() { return Registry(); }
+const std::deque<SourceType>& SourceTypes() { return Registry(); }
 
 const SourceType* FindSourceType(const std::string& name) {
   for (const SourceType& t : Registry()) {
@@ -177,8 +182,8 @@ SourceOptions ParseSourceOptions(config::Section& s) {
       1e6 * s.GetDouble("reorder_window_s", o.reorder_window_us * 1e-6,
                         "LCM log records are re-sorted by event time within this window [s]", 0.0, 10.0));
   // A type's own keys exist only for that type (elsewhere they are unknown keys); describe mode
-  // (--list-stages) documents every type's. With type = auto the type is detected now when the
-  // path exists (otherwise opening it says what is wrong).
+  // (--list-stages) documents every type's. With type = auto the type is detected now (from the
+  // extension alone when the path does not exist; opening it then says what is wrong).
   if (s.describing()) {
     for (const SourceType& t : SourceTypes()) {
       if (t.parse) t.parse(s, &o);
@@ -186,7 +191,16 @@ SourceOptions ParseSourceOptions(config::Section& s) {
     return o;
   }
   std::string type = o.type;
-  if (type == "auto" && std::filesystem::exists(o.path)) type = DetectFormat(o.path);
+  if (type == "auto" && std::filesystem::exists(o.path)) {
+    type = DetectFormat(o.path);
+  } else if (type == "auto") {  // a missing file: its extension still says whose keys these are
+    for (const SourceType& t : SourceTypes()) {
+      if (t.detect && t.detect_order == 0 && t.detect(o.path)) {
+        type = t.name;
+        break;
+      }
+    }
+  }
   if (const SourceType* t = FindSourceType(type); t && t->parse) t->parse(s, &o);
   return o;
 }

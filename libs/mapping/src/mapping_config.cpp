@@ -67,11 +67,10 @@ ActionModelOptions ParseActionModelOptions(config::Section& s, const ActionModel
 
 SensorModelOptions ParseSensorModelOptions(config::Section& s, const SensorModelOptions& defaults) {
   SensorModelOptions sm = defaults;
-  sm.kind = s.GetChoice("sensor_model", "likelihood_field", {"likelihood_field", "simplified"},
-                        "Gaussian of the end point's obstacle distance, or the botlab simplified likelihood field") ==
-                    "likelihood_field"
-                ? SensorModelKind::kLikelihoodField
-                : SensorModelKind::kSimplifiedField;
+  sm.kind = s.GetEnum(
+      "sensor_model", sm.kind,
+      {{"likelihood_field", SensorModelKind::kLikelihoodField}, {"simplified", SensorModelKind::kSimplifiedField}},
+      "Gaussian of the end point's obstacle distance, or the botlab simplified likelihood field");
   sm.ray_stride =
       static_cast<int>(s.GetInt("ray_stride", sm.ray_stride, "use every k-th ray in the sensor model", 1, 1000));
   sm.sigma_m = s.GetDouble("sigma_m", sm.sigma_m, "likelihood field: end-point noise", 0.001);

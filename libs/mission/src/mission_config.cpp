@@ -25,22 +25,25 @@ MissionOptions ParseMissionOptions(config::Section& s) {
                       {"follow", TaskKind::kFollow}},
                      "follow a circuit of waypoints, explore the unknown and return home, make the Warehouse's "
                      "deliveries in the known map, or drive the paths a GUI sends");
+  // Every task's inputs are read whatever the task (a config that names the Warehouse's may run
+  // another task); only the chosen task's are required.
   const bool describing = s.describing();
-  if (o.task == TaskKind::kWaypoints || describing) {
-    o.waypoints =
-        ToPoses(s.GetPoses("waypoints", {}, "waypoints: the circuit in the map frame (SLAM starts at the origin)"));
-    if (o.waypoints.empty() && !describing) s.Fail("waypoints", "task = waypoints needs at least one waypoint");
+  o.waypoints =
+      ToPoses(s.GetPoses("waypoints", {}, "waypoints: the circuit in the map frame (SLAM starts at the origin)"));
+  if (o.task == TaskKind::kWaypoints && o.waypoints.empty() && !describing) {
+    s.Fail("waypoints", "task = waypoints needs at least one waypoint");
   }
-  if (o.task == TaskKind::kWarehouse || describing) {
+  {
     o.targets =
         ToPoses(s.GetPoses("targets", {}, "warehouse: the day's targets (crates to lift) in the known map's frame"));
     o.dropoffs = ToPoses(s.GetPoses("dropoffs", {}, "warehouse: the day's drop-offs in the known map's frame"));
     const size_t needed = static_cast<size_t>(warehouse::TotalDeliveries());
-    if (!describing && o.targets.size() < needed) {
+    const bool warehouse_task = o.task == TaskKind::kWarehouse && !describing;
+    if (warehouse_task && o.targets.size() < needed) {
       s.Fail("targets", "the Warehouse needs " + std::to_string(needed) + " targets, " +
                             std::to_string(o.targets.size()) + " given");
     }
-    if (!describing && o.dropoffs.empty()) s.Fail("dropoffs", "the Warehouse needs at least one drop-off");
+    if (warehouse_task && o.dropoffs.empty()) s.Fail("dropoffs", "the Warehouse needs at least one drop-off");
     o.deliveries =
         static_cast<int>(s.GetInt("deliveries", o.deliveries,
                                   "warehouse: make only the first this many deliveries of the seed's order, for a "

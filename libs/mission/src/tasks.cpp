@@ -144,7 +144,7 @@ class WarehouseTask : public Task {
       need_plan_ = false;
       m.SetGoal(stop.pose);
       m.SetPath(r.path);
-      m.SetState(MissionState::kDriving, "to " + stop.Name() + " of " + std::to_string(warehouse::TotalDeliveries()));
+      m.SetState(MissionState::kDriving, "to " + stop.Name() + " of " + std::to_string(stops_.size() / 2));
     }
     return true;
   }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "mbot/drivers/events.hpp"
+#include "mbot/drivers/sink.hpp"
 
 namespace mbot::drivers {
 
@@ -41,6 +42,9 @@ class Source {
   virtual double Progress() const = 0;
   // A short human name of the input format ("LCM log", "MRPT rawlog (observations only)" …).
   virtual std::string Format() const = 0;
+  // Where the stack's outputs go when the input is a robot (the simulator, live LCM) — the source
+  // itself — or nullptr for a recorded dataset.
+  virtual Sink* sink() { return nullptr; }
   // Format-specific facts for summaries, e.g. {"sensory frames", "37"}.
   virtual std::vector<std::pair<std::string, std::string>> Details() const { return {}; }
   const std::map<std::string, ChannelInfo>& channels() const { return channels_; }

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <any>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <string>
@@ -78,8 +79,9 @@ struct SourceType {
 
 // Adds a type; a second type of the same name is an error (std::logic_error).
 void RegisterSourceType(SourceType type);
-// Every registered type, libs/drivers' own first, in registration order.
-const std::vector<SourceType>& SourceTypes();
+// Every registered type, libs/drivers' own first, in registration order (pointers to them stay
+// valid when more are registered).
+const std::deque<SourceType>& SourceTypes();
 // nullptr when no type has that name.
 const SourceType* FindSourceType(const std::string& name);
 
@@ -90,7 +92,7 @@ SourceOptions ParseSourceOptions(config::Section& section);
 LiveSourceOptions ParseLiveSourceOptions(config::Section& section);
 
 // Opens the input named by the options, detecting the format from its content when type = auto.
-// A source that is also a Sink (the simulator, live LCM) is driven through dynamic_cast to Sink.
+// A source that is also the robot (the simulator, live LCM) takes the stack's outputs: Source::sink().
 // Throws std::runtime_error naming the path when it cannot be read or recognised.
 std::unique_ptr<Source> OpenSource(const SourceOptions& options);
 

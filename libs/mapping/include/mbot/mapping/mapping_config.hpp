@@ -24,8 +24,9 @@ ActionModelOptions ParseActionModelOptions(config::Section& section, const Actio
 // Keys sensor_model (likelihood_field | simplified), ray_stride, sigma_m, max_distance_m,
 // random_weight, log_scale, odds_scale, neighbour_weight, inlier_distance_m.
 SensorModelOptions ParseSensorModelOptions(config::Section& section, const SensorModelOptions& defaults = {});
-// The particle filter's keys (particles, threads, global localization, augmented MCL, lost); the
-// mode decides the defaults of augmented and relocalize_when_lost (on for localization).
+// The particle filter's keys (particles, threads, global localization, augmented MCL, lost). The
+// mode, not `defaults`, decides the defaults of augmented and relocalize_when_lost: on for
+// localization, off for the mapping modes.
 ParticleFilterOptions ParseParticleFilterOptions(config::Section& section, SlamMode mode,
                                                  const ParticleFilterOptions& defaults = {});
 // Key mode (full_slam | localization | mapping_only | action_only) and every key above but the scan's.

@@ -9,7 +9,7 @@ class Section;
 
 namespace mbot::mission {
 
-// Keys task, waypoints, targets, dropoffs, the motion controller's keys
+// Keys task, waypoints, targets, dropoffs, deliveries, the motion controller's keys
 // (motion::ParseMotionControllerOptions), the exploration keys (planning::ParseExplorationOptions),
 // explore_period_s, start_delay_s, max_pose_age_s, control_lag_s, max_corrections, stuck_s,
 // max_stalls, backoff_s, dwell_s. Checks that the task's inputs are there (waypoints for the

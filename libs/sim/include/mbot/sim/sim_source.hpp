@@ -22,6 +22,7 @@ namespace mbot::sim {
 
 class SimSource : public drivers::Source, public drivers::Sink {
  public:
+  drivers::Sink* sink() override { return this; }
   // Loads options.path as the world (World::Load) and places the robot at sim.start, or at the
   // world's `start` pose; options.seed seeds its noise. Throws std::runtime_error naming the path
   // (and [source] start when the world has no start pose) or std::invalid_argument when the start

@@ -83,7 +83,7 @@ class World {
   std::vector<ArenaPose> poses_;
   mapping::OccupancyGrid truth_;
   // Acceleration structures (bucket grid over the walls, or the grid's distance transform), built
-  // once and shared by copies; defined in sim_world.cpp.
+  // once and shared by copies; defined in world.cpp.
   std::shared_ptr<const WorldIndex> index_;
 };
 
