@@ -10,8 +10,7 @@
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/common/strings.hpp"
-#include "mbot/drivers/map_io.hpp"
-#include "mbot/sim/world.hpp"
+#include "mbot/sim/hand_out.hpp"
 #include "stages/report.hpp"
 
 namespace mbot::app {
@@ -24,45 +23,16 @@ std::string Value(const std::vector<std::pair<std::string, std::string>>& kv, co
   return "";
 }
 
-std::string PosesText(const std::vector<motion::Pose2D>& poses) {
-  std::string s;
-  for (const motion::Pose2D& p : poses) {
-    char b[96];
-    std::snprintf(b, sizeof b, "%s%.6g, %.6g, %.6g", s.empty() ? "" : "; ", p.x, p.y, p.theta * 180.0 / M_PI);
-    s += b;
-  }
-  return s;
-}
-
-// Another world for an event: the organisers hand the team that world's inputs through the
-// autonomy's own keys — the circuit, the Warehouse's targets and drop-offs, and the known map
-// (written to `dir`) — since the autonomy never reads the simulator's world.
+// Another world for an event: the organisers hand the team that world's inputs (libs/sim) through
+// the event's own keys, read here with the event's settings.
 void HandOutInputs(const std::string& world_path, const std::string& dir, config::Config* event) {
-  const sim::World world = sim::World::Load(world_path);
-  const sim::EventInputs in = sim::EventInputsOf(world);
-  config::Section mission = event->GetSection("mission");
-  const std::string task = mission.Has("task") ? mission.GetString("task", "", "") : "";
-  if (task == "waypoints") {
-    if (in.waypoints.empty()) {
-      throw config::ConfigError(world_path + " has no 'pose start' and 'pose waypoint' lines: no circuit to hand out");
-    }
-    event->Set("mission.waypoints=" + PosesText(in.waypoints));
-  }
-  if (task == "warehouse") {
-    if (in.targets.empty() || in.dropoffs.empty()) {
-      throw config::ConfigError(world_path +
-                                " has no 'pose target' and 'pose dropoff' lines: no Warehouse to hand out");
-    }
-    event->Set("mission.targets=" + PosesText(in.targets));
-    event->Set("mission.dropoffs=" + PosesText(in.dropoffs));
-  }
-  config::Section slam = event->GetSection("slam");
-  if (slam.Has("mode") && slam.GetString("mode", "", "") == "localization") {
-    const double resolution = slam.GetDouble("resolution_m", mapping::MapperOptions{}.resolution_m, "", 0.001, 10.0);
-    std::filesystem::create_directories(dir);
-    const std::string map_path = dir + "/known_map.map";
-    drivers::WriteBotlabMap(sim::RenderKnownMap(world, resolution), map_path);
-    event->Set("slam.map_file=" + map_path);
+  sim::EventSetup setup;
+  config::Section mission = event->GetSection("mission"), slam = event->GetSection("slam");
+  setup.task = mission.Has("task") ? mission.GetString("task", "", "") : "";
+  setup.localization = slam.Has("mode") && slam.GetString("mode", "", "") == "localization";
+  setup.resolution_m = slam.GetDouble("resolution_m", mapping::MapperOptions{}.resolution_m, "", 0.001, 10.0);
+  for (const std::string& s : sim::HandOut(sim::World::Load(world_path), world_path, setup, dir + "/known_map.map")) {
+    event->Set(s);
   }
 }
 

@@ -317,22 +317,10 @@ std::vector<std::string> Section::GetList(const std::string& key, const std::vec
   return out;
 }
 
-namespace {
-
-std::string PoseText(const PoseValue& p) {
-  std::ostringstream o;
-  o << p.x_m << ", " << p.y_m << ", " << p.theta_rad * 180.0 / M_PI;
-  return o.str();
-}
-
-}  // namespace
-
 std::vector<PoseValue> Section::GetPoses(const std::string& key, const std::vector<PoseValue>& def,
                                          const std::string& doc) {
-  std::vector<std::string> texts;
-  for (const PoseValue& p : def) texts.push_back(PoseText(p));
   const Entry* e =
-      Find(key, "poses", Join(texts, "; "), false, doc + " (x, y, theta_deg per pose; poses separated by ';')");
+      Find(key, "poses", FormatPoses(def), false, doc + " (x, y, theta_deg per pose; poses separated by ';')");
   if (!e) return def;
   std::string text = e->value;
   std::replace(text.begin(), text.end(), ';', ',');
@@ -384,6 +372,15 @@ void Section::Finish() const {
       Fail(key, "unknown key (known keys: " + (known.empty() ? std::string("none") : Join(known, ", ")) + ")");
     }
   }
+}
+
+std::string FormatPoses(const std::vector<PoseValue>& poses) {
+  std::ostringstream o;
+  o.precision(6);
+  for (size_t i = 0; i < poses.size(); ++i) {
+    o << (i ? "; " : "") << poses[i].x_m << ", " << poses[i].y_m << ", " << poses[i].theta_rad * 180.0 / M_PI;
+  }
+  return o.str();
 }
 
 }  // namespace mbot::config

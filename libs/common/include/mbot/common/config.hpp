@@ -158,6 +158,9 @@ class Section {
   std::vector<KeyDoc> docs_;
 };
 
+// Poses as GetPoses reads them: `x, y, theta_deg` each, separated by `; ` (6 significant digits).
+std::string FormatPoses(const std::vector<PoseValue>& poses);
+
 // The folder the `${datasets}` variable expands to: $MBOT_DATASETS_DIR if set, otherwise the
 // build's default (CMake MBOT_DATASETS_DIR).
 std::string DatasetsDir();
