@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <filesystem>
 #include <set>
 #include <sstream>
@@ -15,13 +16,6 @@
 
 namespace mbot::app {
 namespace {
-
-std::string Value(const std::vector<std::pair<std::string, std::string>>& kv, const std::string& key) {
-  for (const auto& [k, v] : kv) {
-    if (k == key) return v;
-  }
-  return "";
-}
 
 // Another world for an event: the organisers hand the team that world's inputs (libs/sim) through
 // the event's own keys, read here with the event's settings.
@@ -36,8 +30,12 @@ void HandOutInputs(const std::string& world_path, const std::string& dir, config
   }
 }
 
+// `v` to `digits` significant digits (the table's precision, kept in competition.json).
+double Round(double v, int digits) { return std::stod(Num(v, digits)); }
+
 struct Row {
-  std::string name, event, arena, seed, result, time_s, points, max_points, collisions, rtf, outputs;
+  std::string name, result, outputs;  // the section, what became of it, where its outputs are
+  std::optional<EventResult> scored;  // the referee's result
 };
 
 }  // namespace
@@ -139,16 +137,9 @@ int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
                     e.plan.source.path + ")");
     try {
       const RunSummary s = RunPlan(e.plan, stop);
-      r.event = Value(s.results, "event");
-      r.arena = Value(s.results, "arena");
-      r.seed = Value(s.results, "seed");
-      r.result = s.interrupted ? "interrupted" : Value(s.results, "result");
-      r.time_s = Value(s.results, "time_s");
-      r.points = Value(s.results, "points");
-      r.max_points = Value(s.results, "max_points");
-      r.collisions = Value(s.results, "collisions");
-      r.rtf = Value(s.results, "real_time_factor");
-      if (r.points.empty()) r.result = "not scored (the referee of " + e.name + " reported no score)";
+      r.scored = s.event_result;
+      if (r.scored) r.result = s.interrupted ? "interrupted" : r.scored->result;
+      if (!r.scored) r.result = "not scored (the referee of " + e.name + " reported no score)";
       if (s.interrupted) status = 130;
     } catch (const std::exception& ex) {
       mbot::log::Error("competition: " + e.name + ": " + ex.what());
@@ -167,15 +158,17 @@ int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
     << std::setw(7) << "RTF"
     << "\n";
   for (const Row& r : rows) {
-    if (r.points.empty()) {
+    if (!r.scored) {
       incomplete = true;
-      t << std::left << std::setw(15) << (r.event.empty() ? r.name : r.event) << r.result << "\n";
+      t << std::left << std::setw(15) << r.name << r.result << "\n";
       continue;
     }
-    total += std::stoi(r.points), max_total += std::stoi(r.max_points);
-    t << std::left << std::setw(15) << r.event << std::setw(22) << r.arena.substr(0, 21) << std::setw(6) << r.seed
-      << std::setw(12) << r.result.substr(0, 11) << std::right << std::setw(8) << r.time_s << std::setw(11)
-      << (r.points + " / " + r.max_points) << std::setw(6) << r.collisions << std::setw(6) << r.rtf << "x\n";
+    const EventResult& e = *r.scored;
+    total += e.points, max_total += e.max_points;
+    t << std::left << std::setw(15) << e.event << std::setw(22) << e.arena.substr(0, 21) << std::setw(6) << e.seed
+      << std::setw(12) << r.result.substr(0, 11) << std::right << std::setw(8) << Num(e.time_s, 4) << std::setw(11)
+      << (std::to_string(e.points) + " / " + std::to_string(e.max_points)) << std::setw(6) << e.collisions
+      << std::setw(6) << Num(e.real_time_factor, 3) << "x\n";
   }
   for (const std::string& n : plan.not_run) {
     const auto colon = n.find(':');
@@ -191,12 +184,14 @@ int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
   j << "{\n  \"events\": [";
   for (size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
-    auto num = [](const std::string& v) { return v.empty() ? std::string("null") : v; };
-    j << (i ? "," : "") << "\n    {\"section\": " << JsonString(r.name) << ", \"event\": " << JsonString(r.event)
-      << ", \"arena\": " << JsonString(r.arena) << ", \"seed\": " << num(r.seed)
-      << ", \"result\": " << JsonString(r.result) << ", \"time_s\": " << num(r.time_s)
-      << ", \"points\": " << num(r.points) << ", \"max_points\": " << num(r.max_points)
-      << ", \"collisions\": " << num(r.collisions) << ", \"real_time_factor\": " << num(r.rtf)
+    const std::optional<EventResult>& e = r.scored;
+    auto num = [&](auto v) { return e ? Num(v) : std::string("null"); };
+    j << (i ? "," : "") << "\n    {\"section\": " << JsonString(r.name)
+      << ", \"event\": " << JsonString(e ? e->event : "") << ", \"arena\": " << JsonString(e ? e->arena : "")
+      << ", \"seed\": " << (e ? std::to_string(e->seed) : "null") << ", \"result\": " << JsonString(r.result)
+      << ", \"time_s\": " << num(e ? Round(e->time_s, 4) : 0.0) << ", \"points\": " << num(e ? e->points : 0)
+      << ", \"max_points\": " << num(e ? e->max_points : 0) << ", \"collisions\": " << num(e ? e->collisions : 0)
+      << ", \"real_time_factor\": " << num(e ? Round(e->real_time_factor, 3) : 0.0)
       << ", \"outputs\": " << JsonString(r.outputs) << "}";
   }
   j << "\n  ],\n  \"not_run\": [";

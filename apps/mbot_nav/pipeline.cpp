@@ -140,8 +140,8 @@ RunSummary RunPlan(PipelinePlan& plan, const std::atomic<bool>& stop) {
   plan.source.seed = plan.pipeline.seed;
   std::unique_ptr<drivers::Source> source = drivers::OpenSource(plan.source);
   PipelineBus bus(plan.stages, source->sink());
-  RunContext ctx{plan.output.dir,  plan.pipeline.seed, source.get(), plan.source.path, &bus,
-                 &summary.results, source->sink()};
+  RunContext ctx{plan.output.dir,       plan.pipeline.seed, source.get(), plan.source.path, &bus,
+                 &summary.event_result, source->sink()};
   for (auto& [name, stage] : plan.stages) stage->Start(ctx);
 
   Progress progress(plan.pipeline.progress);

@@ -40,8 +40,8 @@ struct RunSummary {
   double data_seconds = 0.0;
   double wall_seconds = 0.0;
   bool interrupted = false;
-  std::string stopped_by;                                    // the reason a stage gave when it ended the run, else ""
-  std::vector<std::pair<std::string, std::string>> results;  // what stages reported (RunContext::results)
+  std::string stopped_by;                   // the reason a stage gave when it ended the run, else ""
+  std::optional<EventResult> event_result;  // what a referee reported (RunContext::event_result)
 };
 
 // Opens the source and runs every event through the stages until the end of the input or until

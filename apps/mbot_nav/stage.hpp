@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,15 +32,24 @@ class Bus {
   virtual void RequestStop(const std::string& reason) = 0;
 };
 
+// A competition event's headline result, as its referee reports it: what a caller running several
+// pipelines (the competition) gathers into one table.
+struct EventResult {
+  std::string event, arena;  // "Speed Run", the arena's name
+  uint64_t seed = 0;
+  std::string result;  // the mission's final state, or "time limit"
+  double time_s = 0, real_time_factor = 0;
+  int points = 0, max_points = 0, collisions = 0;
+};
+
 struct RunContext {
   std::string output_dir;  // exists when stages start
   uint64_t seed = 0;       // the one seed all randomness derives from
   const drivers::Source* source = nullptr;
   std::string source_path;
   Bus* bus = nullptr;  // set by the pipeline; valid from Start to Finish
-  // A stage's headline results (key, value), added in Finish, returned in RunSummary::results: what a
-  // caller running several pipelines (the competition) gathers into one table. Valid in Finish.
-  std::vector<std::pair<std::string, std::string>>* results = nullptr;
+  // Set by a referee in Finish, returned in RunSummary::event_result. Valid in Finish.
+  std::optional<EventResult>* event_result = nullptr;
   // Where emitted events end up after the later stages (the simulator, live LCM), or nullptr on a
   // recorded dataset; the bus already forwards to it, so stages read it only to know there is one.
   drivers::Sink* sink = nullptr;

@@ -146,16 +146,9 @@ class RefereeStage : public Stage {
     }
     WriteFileAtomically(dir + "/score.json",
                         [&](std::ostream& out) { out << ScoreJson(s, ctx, arena, interrupted, wall_s); });
-    if (ctx.results) {
-      ctx.results->insert(ctx.results->end(), {{"event", sim::Title(s.event)},
-                                               {"arena", arena},
-                                               {"seed", std::to_string(ctx.seed)},
-                                               {"result", result},
-                                               {"time_s", Num(s.time_s, 4)},
-                                               {"points", std::to_string(s.total)},
-                                               {"max_points", std::to_string(s.max_total)},
-                                               {"collisions", std::to_string(s.collisions)},
-                                               {"real_time_factor", Num(rtf, 3)}});
+    if (ctx.event_result) {
+      *ctx.event_result =
+          EventResult{sim::Title(s.event), arena, ctx.seed, result, s.time_s, rtf, s.total, s.max_total, s.collisions};
     }
   }
 
