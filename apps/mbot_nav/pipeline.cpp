@@ -176,6 +176,13 @@ RunSummary RunPlan(PipelinePlan& plan, const std::atomic<bool>& stop) {
   progress.Done();
   for (auto& [name, stage] : plan.stages) stage->Finish(ctx, summary.interrupted);
   summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  if (summary.events == 0 && !summary.interrupted) {
+    // Nothing passes silently: an empty file, or one whose every record was rejected, is a failed run.
+    const drivers::SourceDiagnostics& d = source->diagnostics();
+    throw std::runtime_error(plan.source.path + ": no usable event in the input (" + source->Format() + "; " +
+                             std::to_string(d.rejected_messages) + " rejected, " + std::to_string(d.unknown_messages) +
+                             " of unknown types" + (d.truncated_tail ? ", truncated" : "") + ")");
+  }
   return summary;
 }
 

@@ -50,6 +50,28 @@ TEST(PipelineTest, StrictErrors) {
       std::string::npos);
 }
 
+// Nothing passes silently: an input without a usable event fails the run, naming the file; a
+// directory given as a log file is named as one.
+TEST(PipelineTest, AnEmptyInputFailsTheRun) {
+  const std::string empty = ::testing::TempDir() + "/empty.log";
+  std::ofstream(empty).flush();
+  auto c = config::Config::FromString(
+      std::string("[pipeline]\nstages = s\nprogress = off\n[source]\ntype = carmen\npath = ") + empty +
+      "\n[output]\ndir = " + ::testing::TempDir() + "/empty_out\n[s]\ntype = inspect\n");
+  PipelinePlan plan = BuildPlan(c);
+  const std::atomic<bool> stop{false};
+  try {
+    RunPlan(plan, stop);
+    ADD_FAILURE();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(empty + ": no usable event"), std::string::npos) << e.what();
+  }
+  c.Set("source.type=lcm_log");
+  c.Set("source.path=" + ::testing::TempDir());
+  PipelinePlan dir_plan = BuildPlan(c);
+  EXPECT_THROW(RunPlan(dir_plan, stop), std::runtime_error);
+}
+
 // Every shipped configuration parses strictly (keys, sections, stage types, values). A fragment
 // (no [pipeline] and no [competition]: defaults.ini, warehouse_day.ini) is checked through the
 // configs that include it, and must be included by one.

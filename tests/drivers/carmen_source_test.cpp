@@ -52,6 +52,32 @@ TEST(CarmenSourceTest, ParsesOldAndNewLinesKeepingPoseAndOdometryApart) {
   EXPECT_EQ(src->diagnostics().rejected_messages, 1);  // the 'bogus' line
 }
 
+// Non-finite numbers are rejected where they enter, with the line; a non-finite range is a beam
+// without a return; a stamp slightly before the log's zero (the Freiburg 079 log has one) is kept.
+TEST(CarmenSourceTest, NonFiniteNumbersAreRejectedWithTheirLine) {
+  const auto path = test::TempPath("nan.log");
+  std::ofstream(path) << "ODOM 1 2 0.5 0 0 0 nan host 1\n"
+                         "ODOM 1 2 inf 0 0 0 2 host 2\n"
+                         "ODOM 1 2 0.5 0 0 0 1e300 host 3\n"
+                         "ODOM 1 2 0.5 0 0 0 -0.9 host 4\n"
+                         "FLASER 2 1.0 inf 0 0 0 0 0 0 5 host 5\n";
+  SourceOptions o;
+  o.path = path;
+  auto src = OpenSource(o);
+  std::vector<Event> ev;
+  while (auto e = src->Next()) ev.push_back(std::move(*e));
+  std::vector<int64_t> odom_times;
+  const LidarScan* scan = nullptr;
+  for (const Event& e : ev) {
+    if (e.channel == "ODOM") odom_times.push_back(e.t_us);
+    if (e.kind == EventKind::kLidar) scan = &std::get<LidarScan>(e.payload);
+  }
+  EXPECT_EQ(odom_times, std::vector<int64_t>{-900000});
+  ASSERT_NE(scan, nullptr);
+  EXPECT_EQ(scan->ranges_m[1], 0.0f);
+  EXPECT_EQ(src->diagnostics().rejected_messages, 3);
+}
+
 TEST(CarmenSourceTest, ReadsGzip) {
   const auto path = test::TempPath("t2.log");
   std::ofstream(path) << "ODOM 1 2 0.5 0 0 0 10.25 host 10.25\n";

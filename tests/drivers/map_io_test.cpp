@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <functional>
 
 #include "test_util.hpp"
 
@@ -71,6 +72,39 @@ TEST(MapIoTest, BadBotlabMapsNameFileAndLine) {
   }
   std::ofstream(path) << "0 0 -3 2 0.05\n";
   EXPECT_THROW(ReadBotlabMap(path), std::runtime_error);
+}
+
+// A header may not ask for more than kMaxMapCells, nor for more cells than the file can hold, nor
+// for an absurd frame: each is an error naming the file and the field, before anything is allocated.
+TEST(MapIoTest, HeadersAreBoundedBeforeAnythingIsAllocated) {
+  auto error_of = [](const std::function<void()>& read) {
+    try {
+      read();
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const auto path = test::TempPath("huge.map");
+  std::ofstream(path) << "0 0 50000 50000 0.05\n0 0 0\n";
+  EXPECT_NE(error_of([&] { ReadBotlabMap(path); }).find("line 1: width x height 50000 x 50000 exceeds the limit"),
+            std::string::npos);
+  std::ofstream(path) << "0 0 10000 10000 0.05\n0 0 0\n";
+  EXPECT_NE(error_of([&] { ReadBotlabMap(path); }).find("10000 x 10000 cells, but the file holds only"),
+            std::string::npos);
+  std::ofstream(path) << "0 0 3 1 1e300\n0 0 0\n";
+  EXPECT_NE(error_of([&] { ReadBotlabMap(path); }).find("resolution 1e+300 is not in"), std::string::npos);
+  std::ofstream(path) << "1e300 0 3 1 0.05\n0 0 0\n";
+  EXPECT_NE(error_of([&] { ReadBotlabMap(path); }).find("is not within"), std::string::npos);
+  const auto mai = test::TempPath("huge_movingai.map");
+  std::ofstream(mai) << "type octile\nheight 100000\nwidth 100000\nmap\n....\n";
+  EXPECT_NE(error_of([&] { ReadMovingAiMap(mai); }).find(mai + ": header width x height 100000 x 100000 exceeds"),
+            std::string::npos);
+  const auto pgm = test::TempPath("huge.pgm"), yaml = test::TempPath("huge.yaml");
+  std::ofstream(pgm) << "P5\n# a comment\n60000 60000\n255\n";
+  std::ofstream(yaml) << "image: huge.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n";
+  EXPECT_NE(error_of([&] { ReadRosMap(yaml); }).find("huge.pgm: PGM header: width x height 60000 x 60000"),
+            std::string::npos);
 }
 
 TEST(MapIoTest, MovingAiMapFlipsRowsAndHandlesCrlf) {

@@ -36,8 +36,19 @@ class Cursor {
     char* end = nullptr;
     const double v = std::strtod(t_[i_].c_str(), &end);
     if (*end != '\0') throw ParseError(std::string("bad number '") + t_[i_] + "' for " + what);
+    if (!std::isfinite(v) || std::abs(v) > 1e12)
+      throw ParseError(std::string("'") + t_[i_] + "' for " + what + " is not a finite number");
     ++i_;
     return v;
+  }
+  // A range or remission: a non-finite value is a beam without a return (0).
+  double Range(const char* what) {
+    if (i_ >= t_.size()) throw ParseError(std::string("line ends before ") + what);
+    char* end = nullptr;
+    const double v = std::strtod(t_[i_].c_str(), &end);
+    if (*end != '\0') throw ParseError(std::string("bad number '") + t_[i_] + "' for " + what);
+    ++i_;
+    return std::isfinite(v) ? v : 0.0;
   }
   int Count(const char* what, int max) {
     const double v = Num(what);
@@ -52,7 +63,13 @@ class Cursor {
   size_t i_ = 1;  // token 0 is the message name
 };
 
-int64_t Micros(double seconds) { return static_cast<int64_t>(std::llround(seconds * 1e6)); }
+int64_t Micros(double seconds) {
+  int64_t t_us = 0;
+  if (!StampFromSeconds(seconds, &t_us)) {
+    throw ParseError("timestamp " + std::to_string(seconds) + " s is beyond the year 2100 either way");
+  }
+  return t_us;
+}
 
 }  // namespace
 
@@ -135,7 +152,7 @@ void CarmenSource::ParseLine(const std::string& line, int line_no) {
       double start, inc;
       GuessBeamGeometry(n, &start, &inc);
       for (int i = 0; i < n; ++i) {
-        scan.ranges_m[i] = static_cast<float>(c.Num("range"));
+        scan.ranges_m[i] = static_cast<float>(c.Range("range"));
         scan.angles_rad[i] = static_cast<float>(start + i * inc);
       }
       scan.max_range_m = static_cast<float>(max_range_m_);
@@ -174,12 +191,12 @@ void CarmenSource::ParseLine(const std::string& line, int line_no) {
       scan.ranges_m.resize(n);
       scan.angles_rad.resize(n);
       for (int i = 0; i < n; ++i) {
-        scan.ranges_m[i] = static_cast<float>(c.Num("range"));
+        scan.ranges_m[i] = static_cast<float>(c.Range("range"));
         scan.angles_rad[i] = static_cast<float>(start + i * inc);
       }
       const int nr = c.Count("num_remissions", 4096);
       scan.intensities.resize(nr);
-      for (int i = 0; i < nr; ++i) scan.intensities[i] = static_cast<float>(c.Num("remission"));
+      for (int i = 0; i < nr; ++i) scan.intensities[i] = static_cast<float>(c.Range("remission"));
       scan.max_range_m = static_cast<float>(max_range);
       int64_t ts;
       if (robot) {

@@ -13,9 +13,7 @@
 
 namespace mbot::drivers {
 
-namespace {
-constexpr int64_t kLatestPlausibleUs = 4'102'444'800'000'000;  // 2100-01-01 in µs since the epoch
-}  // namespace
+namespace {}  // namespace
 
 int64_t WallClockUs() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -57,7 +55,7 @@ struct LcmNode::Impl {
     }
     // utime is µs on the robot's clock (since boot, or the epoch once time-synced): below zero or
     // beyond 2100 it is garbage, whatever the payload says.
-    if (ev.stamp_us < 0 || ev.stamp_us > kLatestPlausibleUs) {
+    if (!IsPlausibleTimeUs(ev.stamp_us)) {
       ++s.rejected;
       s.last_error = "absurd timestamp utime = " + std::to_string(ev.stamp_us);
       mbot::log::WarnOnce("lcm_live:time:" + channel,

@@ -36,6 +36,45 @@ std::string ShortestDouble(double v) {
 
 [[noreturn]] void Fail(const std::string& path, const std::string& why) { throw std::runtime_error(path + ": " + why); }
 
+// A header's claim of `w` × `h` cells, each at least `bytes_per_cell` bytes in the file: within
+// kMaxMapCells and what the file can hold. `where` names the field ("line 1: width x height").
+void CheckDeclaredCells(const std::string& path, const std::string& where, long long w, long long h,
+                        double bytes_per_cell) {
+  if (w <= 0 || h <= 0) Fail(path, where + " " + std::to_string(w) + " x " + std::to_string(h) + " is not a size");
+  if (w > kMaxMapCells / h) {
+    Fail(path, where + " " + std::to_string(w) + " x " + std::to_string(h) + " exceeds the limit of " +
+                   std::to_string(kMaxMapCells) + " cells");
+  }
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  if (!ec && static_cast<double>(w) * h * bytes_per_cell > static_cast<double>(size) + 1.0) {
+    Fail(path, where + " " + std::to_string(w) + " x " + std::to_string(h) + " cells, but the file holds only " +
+                   std::to_string(size) + " bytes");
+  }
+}
+
+// Origins and resolutions a map may have (see map_io.hpp).
+void CheckFrame(const std::string& path, const std::string& where, double ox, double oy, double res) {
+  if (!std::isfinite(ox) || !std::isfinite(oy) || std::abs(ox) > 1e6 || std::abs(oy) > 1e6) {
+    Fail(path, where + " origin (" + ShortestDouble(ox) + ", " + ShortestDouble(oy) + ") is not within ±1e6 m");
+  }
+  if (!(res >= 1e-4 && res <= 100.0))
+    Fail(path, where + " resolution " + ShortestDouble(res) + " is not in [1e-4, 100] m");
+}
+
+// A PGM image's declared size (P2 text or P5 binary), checked before OpenCV allocates it.
+void CheckPgmHeader(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string magic;
+  if (!(in >> magic) || (magic != "P5" && magic != "P2")) return;  // another image format: OpenCV's to judge
+  long long v[3];
+  for (long long& x : v) {
+    while (in >> std::ws && in.peek() == '#') in.ignore(1 << 20, '\n');
+    if (!(in >> x)) Fail(path, "PGM header: expected width, height and maximum value");
+  }
+  CheckDeclaredCells(path, "PGM header: width x height", v[0], v[1], magic == "P5" ? 1.0 : 2.0);
+}
+
 }  // namespace
 
 mapping::OccupancyGrid ReadBotlabMap(const std::string& path) {
@@ -45,10 +84,8 @@ mapping::OccupancyGrid ReadBotlabMap(const std::string& path) {
   long long w, h;
   if (!(in >> ox >> oy >> w >> h >> res))
     Fail(path, "line 1: expected 'origin_x origin_y width height meters_per_cell'");
-  if (w <= 0 || h <= 0 || w * h > (1LL << 31) || !(res > 0) || !std::isfinite(ox) || !std::isfinite(oy)) {
-    Fail(path, "line 1: implausible header (" + std::to_string(w) + "x" + std::to_string(h) + ", resolution " +
-                   ShortestDouble(res) + ")");
-  }
+  CheckDeclaredCells(path, "line 1: width x height", w, h, 2.0);  // a value and a separator per cell
+  CheckFrame(path, "line 1:", ox, oy, res);
   mapping::OccupancyGrid grid(static_cast<int>(w), static_cast<int>(h), res, ox, oy);
   for (long long y = 0; y < h; ++y) {
     for (long long x = 0; x < w; ++x) {
@@ -137,7 +174,9 @@ mapping::OccupancyGrid ReadRosMap(const std::string& yaml_path) {
   if (std::abs(yaw) > 1e-9)
     Fail(yaml_path, "origin yaw " + ShortestDouble(yaw) + " is not supported (only axis-aligned maps)");
   if (mode != "trinary" && mode != "scale") Fail(yaml_path, "mode '" + mode + "' is not supported (trinary, scale)");
+  CheckFrame(yaml_path, "", ox, oy, res);
   const fs::path img_path = fs::path(image).is_absolute() ? fs::path(image) : fs::path(yaml_path).parent_path() / image;
+  CheckPgmHeader(img_path.string());
   cv::Mat img = cv::imread(img_path.string(), cv::IMREAD_GRAYSCALE);
   if (img.empty()) Fail(img_path.string(), "cannot read map image (named in " + yaml_path + ")");
   mapping::OccupancyGrid grid(img.cols, img.rows, res, ox, oy);
@@ -267,6 +306,7 @@ mapping::OccupancyGrid ReadMovingAiMap(const std::string& path) {
       Fail(path, "line " + std::to_string(line_no) + ": unexpected header '" + Trim(line) + "'");
   }
   if (w <= 0 || h <= 0) Fail(path, "missing width/height header");
+  CheckDeclaredCells(path, "header width x height", w, h, 1.0);
   mapping::OccupancyGrid grid(w, h, 1.0, 0.0, 0.0);
   for (int r = 0; r < h; ++r) {
     if (!std::getline(in, line)) Fail(path, "ends after " + std::to_string(r) + " of " + std::to_string(h) + " rows");

@@ -229,6 +229,10 @@ std::unique_ptr<Source> OpenSource(const SourceOptions& options) {
   const std::string type = options.type == "auto" ? DetectFormat(options.path) : options.type;
   const SourceType* t = FindSourceType(type);
   if (!t) throw std::runtime_error("source type '" + type + "' is not known");
+  // Only the A* cases come as a folder; a folder anywhere else would read as an empty file.
+  if (type != "astar_cases" && type != "lcm_live" && std::filesystem::is_directory(options.path)) {
+    throw std::runtime_error(options.path + ": is a directory, not a " + type + " file");
+  }
   return t->open(options);
 }
 

@@ -2,6 +2,7 @@
 // map file, simulator) turns its input into. Times are microseconds on the data's clock.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -15,6 +16,19 @@
 #include "mbot/motion/pose2d.hpp"
 
 namespace mbot::drivers {
+
+// The bound on every time the readers let in: within ±kLatestPlausibleUs (2100-01-01 in µs since the
+// epoch), so the pipeline's time arithmetic (differences of two stamps) cannot overflow. A robot's
+// utime (µs since the epoch, or since it booted) must also not be negative.
+inline constexpr int64_t kLatestPlausibleUs = 4'102'444'800'000'000;
+inline bool IsPlausibleTimeUs(int64_t t_us) { return t_us >= 0 && t_us <= kLatestPlausibleUs; }
+// A stamp in seconds (CARMEN and other text logs, which may count from the log's start and so go
+// slightly negative) as µs; false when it is not finite or beyond ±kLatestPlausibleUs.
+inline bool StampFromSeconds(double seconds, int64_t* t_us) {
+  if (!(std::abs(seconds) <= kLatestPlausibleUs * 1e-6)) return false;  // also rejects NaN
+  *t_us = static_cast<int64_t>(std::llround(seconds * 1e6));
+  return true;
+}
 
 struct LidarScan {
   std::vector<float> ranges_m;         // <= 0 or NaN: no return

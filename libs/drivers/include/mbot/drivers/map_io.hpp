@@ -14,6 +14,12 @@ namespace mbot::drivers {
 
 // botlab: "origin_x origin_y width height meters_per_cell", then `height` rows of `width` int8
 // log-odds, row y = 0 first. Lossless round trip.
+// What a map file's header may ask for: at most kMaxMapCells cells (a 16,384 × 16,384 grid, 256 MB
+// of int8), no more cells than the file's bytes can hold (a text map spends at least one byte per
+// cell, a binary PGM exactly one), origins within ±1e6 m and a resolution in [1e-4, 100] m. A header
+// beyond them is an error naming the file, the field and the value, before anything is allocated.
+inline constexpr long long kMaxMapCells = 1LL << 28;
+
 mapping::OccupancyGrid ReadBotlabMap(const std::string& path);
 void WriteBotlabMap(const mapping::OccupancyGrid& grid, const std::string& path);
 
