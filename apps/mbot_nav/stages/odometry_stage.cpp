@@ -170,8 +170,9 @@ StageType OdometryStageType() {
                             "gyrodometry: use the gyro when gyro and encoder turn rates differ by more than this", 0.0);
             o.fusion.gyro_weight = s.GetDouble("gyro_weight", o.fusion.gyro_weight,
                                                "complementary: share of the gyro's heading change", 0.0, 1.0);
-            o.fusion.gyro_scale = s.GetDouble("gyro_scale", o.fusion.gyro_scale,
-                                              "multiplies the gyro's yaw rate (0.0174533 for a gyro reporting deg/s)");
+            o.fusion.gyro_scale =
+                s.GetDouble("gyro_scale", o.fusion.gyro_scale,
+                            "multiplies the gyro's yaw rate (0.0174533 for a gyro reporting deg/s)", -100.0, 100.0);
             o.use_stamps =
                 s.GetChoice("clock", "stamp", {"stamp", "event"},
                             "integrate on the messages' own stamps (the robot's clock) or on the log's event times") ==

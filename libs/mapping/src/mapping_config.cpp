@@ -44,10 +44,16 @@ MapperOptions ParseMapperOptions(config::Section& s, const MapperOptions& defaul
   mp.miss_odds =
       static_cast<int>(s.GetInt("miss_odds", mp.miss_odds, "log-odds removed from the cells a ray crosses", 0, 127));
   mp.resolution_m = s.GetDouble("resolution_m", mp.resolution_m, "cell size", 0.001, 10.0);
-  mp.width_m = s.GetDouble("width_m", mp.width_m, "initial map width", 0.01);
-  mp.height_m = s.GetDouble("height_m", mp.height_m, "initial map height", 0.01);
-  mp.center_x_m = s.GetDouble("center_x_m", mp.center_x_m, "initial map centre x");
-  mp.center_y_m = s.GetDouble("center_y_m", mp.center_y_m, "initial map centre y");
+  mp.width_m = s.GetDouble("width_m", mp.width_m, "initial map width", 0.01, 1e5);
+  mp.height_m = s.GetDouble("height_m", mp.height_m, "initial map height", 0.01, 1e5);
+  mp.center_x_m = s.GetDouble("center_x_m", mp.center_x_m, "initial map centre x", -1e6, 1e6);
+  mp.center_y_m = s.GetDouble("center_y_m", mp.center_y_m, "initial map centre y", -1e6, 1e6);
+  // The grid these ask for must be one a computer can hold (2^28 cells, as for map files).
+  const double cells = std::ceil(mp.width_m / mp.resolution_m) * std::ceil(mp.height_m / mp.resolution_m);
+  if (cells > double(1LL << 28)) {
+    s.Fail("width_m", "a " + std::to_string(mp.width_m) + " x " + std::to_string(mp.height_m) + " m map at " +
+                          std::to_string(mp.resolution_m) + " m is more than 2^28 cells");
+  }
   mp.grow = s.GetBool("grow", mp.grow, "grow the map when scans reach its edge (false: clip)");
 
   return mp;
