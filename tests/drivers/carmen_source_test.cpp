@@ -78,6 +78,22 @@ TEST(CarmenSourceTest, NonFiniteNumbersAreRejectedWithTheirLine) {
   EXPECT_EQ(src->diagnostics().rejected_messages, 3);
 }
 
+// Old Mac line ends (CR alone) and Windows ones (CRLF) read like LF: every record, numbered.
+TEST(CarmenSourceTest, EveryLineEndIsALineEnd) {
+  for (const char* end : {"\r", "\r\n", "\n"}) {
+    const auto path = test::TempPath("cr.log");
+    std::ofstream(path) << "ODOM 1 2 0.5 0 0 0 1 host 1" << end << "ODOM 1 2 0.5 0 0 0 2 host 2" << end
+                        << "ODOM 1 2 bogus 0 0 0 3 host 3" << end;
+    SourceOptions o;
+    o.path = path;
+    auto src = OpenSource(o);
+    int n = 0;
+    while (src->Next()) ++n;
+    EXPECT_EQ(n, 2) << "line end " << (end[0] == '\r' && !end[1] ? "CR" : end[1] ? "CRLF" : "LF");
+    EXPECT_EQ(src->diagnostics().rejected_messages, 1);
+  }
+}
+
 TEST(CarmenSourceTest, ReadsGzip) {
   const auto path = test::TempPath("t2.log");
   std::ofstream(path) << "ODOM 1 2 0.5 0 0 0 10.25 host 10.25\n";

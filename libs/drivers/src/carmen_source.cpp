@@ -98,11 +98,24 @@ CarmenSource::CarmenSource(const SourceOptions& options) : options_(options), ma
   std::string line;
   char buf[1 << 16];
   int line_no = 0;
+  constexpr size_t kMaxLine = 64 << 20;  // no CARMEN record comes near; a file without line ends does
   while (gzgets(f, buf, sizeof buf)) {
     line += buf;
-    if (!line.empty() && line.back() != '\n' && !gzeof(f)) continue;  // a line longer than buf
-    ++line_no;
-    ParseLine(line, line_no);
+    if (!line.empty() && line.back() != '\n' && !gzeof(f)) {  // a line longer than buf
+      if (line.size() <= kMaxLine || line.find('\r') != std::string::npos) continue;
+      mbot::log::Warn(options.path + ": line " + std::to_string(line_no + 1) +
+                      " runs past 64 MB without a line end; the rest of the file is not read");
+      diagnostics_.truncated_tail = true;
+      break;
+    }
+    // Records end with LF, CRLF or (old Mac files) CR alone: each CR-separated piece is a line.
+    for (size_t b = 0; b < line.size();) {
+      size_t e = line.find('\r', b);
+      if (e == std::string::npos) e = line.size();
+      const std::string piece = line.substr(b, e - b);
+      if (b == 0 || !(piece.empty() || piece == "\n")) ParseLine(piece, ++line_no);
+      b = e + 1;
+    }
     line.clear();
   }
   int err = 0;
