@@ -1,5 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <vector>
+
+#include <iterator>
+
+#include <fstream>
+
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CRawlog.h>
@@ -48,6 +54,34 @@ TEST(RawlogSourceTest, ObservationsOnlyFormatIsReadInTimeOrder) {
   EXPECT_EQ(b->t_us - a->t_us, 500000);
   EXPECT_NEAR(std::get<motion::Pose2D>(b->payload).y, 2.0, 1e-9);
   EXPECT_FALSE(src->Next());
+}
+
+// A rawlog cut short keeps what was read, and says it was cut (MRPT's own loader stops quietly).
+TEST(RawlogSourceTest, ARawlogCutShortIsReported) {
+  mrpt::obs::CRawlog rawlog;
+  for (int i = 0; i < 200; ++i) {
+    auto odo = mrpt::obs::CObservationOdometry::Create();
+    odo->sensorLabel = "ODOMETRY";
+    odo->timestamp = mrpt::Clock::fromDouble(1000.0 + i);
+    odo->odometry = mrpt::poses::CPose2D(0.01 * i, 0.0, 0.0);
+    rawlog.insert(odo);
+  }
+  const auto whole = test::TempPath("whole.rawlog"), cut = test::TempPath("cut.rawlog");
+  ASSERT_TRUE(rawlog.saveToRawLogFile(whole));
+  std::ifstream in(whole, std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::ofstream(cut, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size() * 7 / 10));
+  SourceOptions o;
+  o.path = whole;
+  auto full = OpenSource(o);
+  EXPECT_FALSE(full->diagnostics().truncated_tail);
+  o.path = cut;
+  auto src = OpenSource(o);
+  int n = 0;
+  while (src->Next()) ++n;
+  EXPECT_GT(n, 0);
+  EXPECT_LT(n, 200);
+  EXPECT_TRUE(src->diagnostics().truncated_tail);
 }
 
 TEST(RawlogSourceTest, NotARawlogIsAnErrorNamingTheFile) {

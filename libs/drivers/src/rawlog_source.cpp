@@ -6,6 +6,8 @@
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CRawlog.h>
 #include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/serialization/CArchive.h>
 
 #include <algorithm>
 #include <cmath>
@@ -17,6 +19,45 @@
 
 namespace mbot::drivers {
 namespace {
+
+// The line of an MRPT exception that says what happened (its text after "Message:"), else its first.
+std::string MrptMessage(const std::string& what) {
+  const size_t m = what.find("Message:");
+  const size_t b = m == std::string::npos ? 0 : what.find_first_not_of(' ', m + 8);
+  const std::string line = what.substr(b == std::string::npos ? 0 : b);
+  return line.substr(0, line.find('\n'));
+}
+
+// The rawlog's entries, as MRPT's CRawlog::loadFromRawLogFile reads them (one CRawlog object, or a
+// sequence of sensory frames, action collections and observations) — except that a record cut short
+// is reported in *cut instead of ending the read quietly. False when the file cannot be opened.
+bool LoadRawlog(const std::string& path, mrpt::obs::CRawlog* rawlog, std::string* cut) {
+  mrpt::io::CFileGZInputStream fs;
+  if (!fs.open(path)) return false;
+  auto arch = mrpt::serialization::archiveFrom(fs);
+  for (;;) {
+    mrpt::serialization::CSerializable::Ptr obj;
+    try {
+      obj = arch.ReadObject();
+    } catch (const mrpt::serialization::CExceptionEOF&) {
+      return true;  // the end, at a record boundary
+    } catch (const std::exception& e) {
+      *cut = "a record it could not read (" + MrptMessage(e.what()) + ")";
+      return true;
+    }
+    if (auto whole = std::dynamic_pointer_cast<mrpt::obs::CRawlog>(obj)) {
+      *rawlog = std::move(*whole);
+    } else if (std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj) ||
+               std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(obj) ||
+               std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj)) {
+      rawlog->insert(obj);
+    } else {
+      *cut = std::string("an object of class ") + (obj ? obj->GetRuntimeClass()->className : "null") +
+             ", which a rawlog does not hold";
+      return true;
+    }
+  }
+}
 
 int64_t ToMicros(mrpt::Clock::time_point t) {
   if (t == mrpt::Clock::time_point()) return INT64_MIN;
@@ -38,13 +79,19 @@ std::string Label(const mrpt::obs::CObservation& obs) {
 RawlogSource::RawlogSource(const SourceOptions& options) {
   if (!std::filesystem::is_regular_file(options.path)) throw std::runtime_error(options.path + ": no such file");
   mrpt::obs::CRawlog rawlog;
+  std::string cut;
   bool ok = false;
   try {
-    ok = rawlog.loadFromRawLogFile(options.path);
+    ok = LoadRawlog(options.path, &rawlog, &cut);
   } catch (const std::exception& e) {
-    throw std::runtime_error(options.path + ": cannot read MRPT rawlog: " + e.what());
+    throw std::runtime_error(options.path + ": cannot read MRPT rawlog: " + MrptMessage(e.what()));
   }
   if (!ok) throw std::runtime_error(options.path + ": cannot read MRPT rawlog");
+  if (!cut.empty()) {
+    diagnostics_.truncated_tail = true;
+    mbot::log::Warn(options.path + ": the rawlog stops after " + std::to_string(rawlog.size()) + " entries, at " + cut +
+                    "; keeping what was read");
+  }
   if (rawlog.size() == 0) mbot::log::Warn(options.path + ": the rawlog holds no entries");
 
   motion::Pose2D odom;  // integrated from the actions of the Actions/SensoryFrame format
