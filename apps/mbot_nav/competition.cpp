@@ -30,9 +30,6 @@ void HandOutInputs(const std::string& world_path, const std::string& dir, config
   }
 }
 
-// `v` to `digits` significant digits (the table's precision, kept in competition.json).
-double Round(double v, int digits) { return std::stod(Num(v, digits)); }
-
 struct Row {
   std::string name, result, outputs;  // the section, what became of it, where its outputs are
   std::optional<EventResult> scored;  // the referee's result
@@ -185,13 +182,13 @@ int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
   for (size_t i = 0; i < rows.size(); ++i) {
     const Row& r = rows[i];
     const std::optional<EventResult>& e = r.scored;
-    auto num = [&](auto v) { return e ? Num(v) : std::string("null"); };
+    auto num = [&](double v, int digits = 6) { return e ? Num(v, digits) : std::string("null"); };
     j << (i ? "," : "") << "\n    {\"section\": " << JsonString(r.name)
       << ", \"event\": " << JsonString(e ? e->event : "") << ", \"arena\": " << JsonString(e ? e->arena : "")
       << ", \"seed\": " << (e ? std::to_string(e->seed) : "null") << ", \"result\": " << JsonString(r.result)
-      << ", \"time_s\": " << num(e ? Round(e->time_s, 4) : 0.0) << ", \"points\": " << num(e ? e->points : 0)
+      << ", \"time_s\": " << num(e ? e->time_s : 0.0, 4) << ", \"points\": " << num(e ? e->points : 0)
       << ", \"max_points\": " << num(e ? e->max_points : 0) << ", \"collisions\": " << num(e ? e->collisions : 0)
-      << ", \"real_time_factor\": " << num(e ? Round(e->real_time_factor, 3) : 0.0)
+      << ", \"real_time_factor\": " << num(e ? e->real_time_factor : 0.0, 3)
       << ", \"outputs\": " << JsonString(r.outputs) << "}";
   }
   j << "\n  ],\n  \"not_run\": [";

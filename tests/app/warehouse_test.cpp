@@ -4,16 +4,12 @@
 
 #include <gtest/gtest.h>
 
-#include <filesystem>
-#include <fstream>
 #include <set>
-#include <sstream>
 
 #include "mbot/common/config.hpp"
 #include "mbot/drivers/map_io.hpp"
 #include "mbot/sim/world.hpp"
 #include "mbot/mission/mission_config.hpp"
-#include "stage.hpp"
 
 namespace mbot::app {
 namespace {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mbot/common/atomic_file.hpp"
+#include "mbot/common/strings.hpp"
 #include "mbot/motion/pose2d.hpp"
 #include "mbot/motion/trajectory_error.hpp"
 
@@ -43,12 +44,7 @@ inline std::string TumLine(double t_s, double x, double y, double theta) {
 }
 
 // A number for JSON: non-finite values become null.
-inline std::string Num(double v, int precision = 6) {
-  if (!std::isfinite(v)) return "null";
-  std::ostringstream s;
-  s << std::setprecision(precision) << v;
-  return s.str();
-}
+inline std::string Num(double v, int precision = 6) { return std::isfinite(v) ? Significant(v, precision) : "null"; }
 
 // min / mean / median / max / std of a sample, the form the botlab reports print their timings in.
 struct SampleStats {

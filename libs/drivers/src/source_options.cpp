@@ -96,8 +96,8 @@ bool IsCases(const std::string& path, const char* type) {
 }
 
 // libs/drivers' own types; detect_order < 0 may name a folder, the others need a regular file.
-std::vector<SourceType> BuiltInTypes() {
-  std::vector<SourceType> t;
+std::deque<SourceType> BuiltInTypes() {
+  std::deque<SourceType> t;
   t.push_back({"astar_cases",
                "the botlab A* test cases: a folder of *_poses.txt files beside their maps, or one of them",
                [](const std::string& p) { return IsCases(p, "astar_cases"); }, -1, nullptr,
@@ -126,10 +126,7 @@ std::vector<SourceType> BuiltInTypes() {
 
 // A deque: registering a type never moves the ones before it (FindSourceType's pointers stay valid).
 std::deque<SourceType>& Registry() {
-  static std::deque<SourceType> types = [] {
-    std::vector<SourceType> v = BuiltInTypes();
-    return std::deque<SourceType>(v.begin(), v.end());
-  }();
+  static std::deque<SourceType> types = BuiltInTypes();
   return types;
 }
 

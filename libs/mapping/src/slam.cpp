@@ -1,6 +1,6 @@
 #include "mbot/mapping/slam.hpp"
 
-#include <sstream>
+#include "mbot/common/strings.hpp"
 
 #include <stdexcept>
 
@@ -32,29 +32,23 @@ SlamState StateOf(SlamMode mode, const FilterStatus& status) {
 }
 
 std::string SlamEventTracker::Add(double t, int scan, bool updated, const FilterStatus& status) {
-  auto num = [](double v, int digits) {
-    std::ostringstream o;
-    o.precision(digits);
-    o << v;
-    return o.str();
-  };
   std::string said;
   if (global_ && converged_at_s_ < 0 && updated && status.converged) {
     converged_at_s_ = t;
     converged_scan_ = scan;
-    said = "global localization converged after " + std::to_string(scan + 1) + " scans (" + num(t, 4) + " s), spread " +
-           num(status.spread_m, 3) + " m";
+    said = "global localization converged after " + std::to_string(scan + 1) + " scans (" + Significant(t, 4) +
+           " s), spread " + Significant(status.spread_m, 3) + " m";
   }
   const bool open = !lost_.empty() && lost_.back().recovered_at_scan < 0;
   if (status.lost && !open) {
     lost_.push_back({t, scan, -1, -1});
-    said += (said.empty() ? "" : "; ") + std::string("lost at ") + num(t, 4) + " s (inlier share " +
-            num(status.inlier_fraction, 3) + ")";
+    said += (said.empty() ? "" : "; ") + std::string("lost at ") + Significant(t, 4) + " s (inlier share " +
+            Significant(status.inlier_fraction, 3) + ")";
   } else if (open && updated && status.converged && !status.lost &&
              status.inlier_fraction >= recovered_inlier_fraction_) {
     lost_.back().recovered_at_s = t;
     lost_.back().recovered_at_scan = scan;
-    said += (said.empty() ? "" : "; ") + std::string("recovered at ") + num(t, 4) + " s";
+    said += (said.empty() ? "" : "; ") + std::string("recovered at ") + Significant(t, 4) + " s";
   }
   return said;
 }

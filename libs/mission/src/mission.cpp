@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "mbot/common/log.hpp"
+#include "mbot/common/strings.hpp"
 #include "tasks.hpp"
 
 namespace mbot::mission {
@@ -19,12 +19,6 @@ constexpr double kTurnOnlyWithin = 1.5;
 
 // Paths ending this close to the previous one's end lead to the same goal (the stall budget carries on).
 constexpr double kSameGoalM = 0.10;
-
-std::string Fixed(double v, int digits) {
-  char b[64];
-  std::snprintf(b, sizeof b, "%.*g", digits, v);
-  return b;
-}
 
 }  // namespace
 
@@ -130,7 +124,7 @@ bool Mission::Recovering() {
     return true;
   }
   ++recoveries_;
-  mbot::log::Warn("mission: stalled for " + Fixed(o_.stuck_s, 3) + " s while commanded to move: backing off");
+  mbot::log::Warn("mission: stalled for " + Significant(o_.stuck_s, 3) + " s while commanded to move: backing off");
   stuck_since_us_ = -1;
   last_command_ = {};
   backoff_until_us_ = t_us_ + static_cast<int64_t>(o_.backoff_s * 1e6);
@@ -154,8 +148,8 @@ bool Mission::Settled(const Pose2D& pose, std::string* how) {
   const double tolerance = o_.controller.final_tolerance_m * (corrections_ > 0 ? kTurnOnlyWithin : 1.0);
   const bool heading_ok = e <= o_.controller.final_heading_tolerance_rad;
   if ((d <= tolerance && heading_ok) || corrections_ >= o_.max_corrections) {
-    *how = std::to_string(corrections_) + " corrections; off by " + Fixed(d, 3) + " m, " + Fixed(e * 180 / M_PI, 3) +
-           " deg by its own estimate";
+    *how = std::to_string(corrections_) + " corrections; off by " + Significant(d, 3) + " m, " +
+           Significant(e * 180 / M_PI, 3) + " deg by its own estimate";
     return true;
   }
   ++corrections_, ++total_corrections_;

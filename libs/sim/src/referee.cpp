@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "mbot/common/log.hpp"
+#include "mbot/common/strings.hpp"
 
 namespace mbot::sim {
 namespace {
@@ -14,13 +15,6 @@ namespace {
 namespace warehouse = mission::warehouse;
 using motion::Pose2D;
 using motion::TimedPose;
-
-std::string Fixed(double v, int digits) {
-  std::ostringstream s;
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
 
 std::string Errors(const PoseError& e) {
   char b[80];
@@ -134,7 +128,7 @@ std::optional<std::string> Referee::StopReason(int64_t t_us) {
   if (t0_us_ >= 0 && (t_us - t0_us_) * 1e-6 >= o_.time_limit_s) {
     stop_sent_ = true;
     timed_out_ = true;
-    return "referee: time limit of " + Fixed(o_.time_limit_s, 4) + " s";
+    return "referee: time limit of " + Significant(o_.time_limit_s, 4) + " s";
   }
   return std::nullopt;
 }
@@ -163,7 +157,7 @@ void Referee::JudgeStop(const TimedPose& truth) {
   stop_done_us_.push_back(truth.t_us);
   near_stop_ = -1;
   left_last_stop_ = false;
-  mbot::log::Info("referee: " + stops_[at].Name() + " done at " + Fixed((truth.t_us - t0_us_) * 1e-6, 4) + " s");
+  mbot::log::Info("referee: " + stops_[at].Name() + " done at " + Significant((truth.t_us - t0_us_) * 1e-6, 4) + " s");
 }
 
 Score Referee::Judge() const {
@@ -198,11 +192,11 @@ Score Referee::Judge() const {
     s.map = mq;
     s.items.push_back(
         {"map quality",
-         "coverage " + Fixed(100 * mq.coverage, 3) + " %, walls " + Fixed(100 * mq.precision, 3) +
+         "coverage " + Significant(100 * mq.coverage, 3) + " %, walls " + Significant(100 * mq.precision, 3) +
              " % within 1.5 cells",
          static_cast<int>(std::floor(100.0 * std::min(1.0, std::min(mq.coverage / 0.99, mq.precision / 0.95))))});
     if (o_.event == CompetitionEvent::kSpeedRun) {
-      s.items.push_back({"lap time", Fixed(s.time_s, 4) + " s", s.completed ? LapPoints(s.time_s) : 0});
+      s.items.push_back({"lap time", Significant(s.time_s, 4) + " s", s.completed ? LapPoints(s.time_s) : 0});
     } else {
       s.items.push_back(
           {"autonomy", s.completed ? "explored and home, no help" : "not completed", s.completed ? 100 : 0});
@@ -210,9 +204,10 @@ Score Referee::Judge() const {
   } else {
     if (localized_us_ >= 0) s.localized_at_s = (localized_us_ - t0_us_) * 1e-6;
     s.items.push_back({"localization",
-                       s.localized_at_s ? "settled in " + Fixed(*s.localized_at_s, 3) + " s; at the end SLAM off by " +
-                                              (s.slam_final_error ? Errors(*s.slam_final_error) : std::string("?"))
-                                        : "global localization never settled",
+                       s.localized_at_s
+                           ? "settled in " + Significant(*s.localized_at_s, 3) + " s; at the end SLAM off by " +
+                                 (s.slam_final_error ? Errors(*s.slam_final_error) : std::string("?"))
+                           : "global localization never settled",
                        s.localized_at_s && s.slam_final_error ? PosePoints(*s.slam_final_error) : 0});
     for (size_t k = 0; k < stops_.size(); ++k) {
       StopResult r{stops_[k], std::nullopt, false};
@@ -238,8 +233,8 @@ Score Referee::Judge() const {
       if (reached) s.levels_reached = static_cast<int>(l) + 1;
       s.items.push_back({"level " + std::to_string(l + 1),
                          std::to_string(std::min(in_time, needed)) + " of " + std::to_string(needed) +
-                             (needed == 1 ? " delivery" : " deliveries") + " by " + Fixed(level.deadline_s, 4) + " s" +
-                             (reached ? " (the last at " + Fixed(made_at_s[needed - 1], 4) + " s)" : ""),
+                             (needed == 1 ? " delivery" : " deliveries") + " by " + Significant(level.deadline_s, 4) +
+                             " s" + (reached ? " (the last at " + Significant(made_at_s[needed - 1], 4) + " s)" : ""),
                          reached ? 100 : 0});
     }
   }

@@ -1,6 +1,7 @@
 // Small string helpers the file readers share.
 #pragma once
 
+#include <sstream>
 #include <string>
 
 namespace mbot {
@@ -15,6 +16,15 @@ inline std::string Trim(const std::string& s) {
 // True when `s` ends with `suffix` (file extensions).
 inline bool EndsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// `v` with at most `digits` significant digits, as an ostream prints it ("14.77", "1e+300", "nan"):
+// the one number format of log lines, rubric details and reports.
+inline std::string Significant(double v, int digits = 6) {
+  std::ostringstream s;
+  s.precision(digits);
+  s << v;
+  return s.str();
 }
 
 }  // namespace mbot
