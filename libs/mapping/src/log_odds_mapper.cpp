@@ -21,20 +21,24 @@ void LogOddsMapper::Reset(OccupancyGrid map) {
   map_ = std::move(map);
 }
 
-void LogOddsMapper::EnsureCovers(double min_x, double min_y, double max_x, double max_y) {
+bool LogOddsMapper::EnsureCovers(double min_x, double min_y, double max_x, double max_y) {
   const double res = map_.resolution();
   const double x0 = map_.origin_x(), y0 = map_.origin_y();
   const double x1 = x0 + map_.width() * res, y1 = y0 + map_.height() * res;
-  if (min_x >= x0 && min_y >= y0 && max_x < x1 && max_y < y1) return;
-  // Grow by whole blocks (a multiple of the cell size) on each side that is short.
-  const int block = std::max(1, static_cast<int>(std::lround(options_.grow_block_m / res)));
+  if (min_x >= x0 && min_y >= y0 && max_x < x1 && max_y < y1) return true;
+  // Grow by whole blocks (a multiple of the cell size) on each side that is short, in doubles
+  // first: a corrupt range must not overflow the cell counts.
+  const double block = std::max(1.0, std::round(options_.grow_block_m / res));
   auto cells_needed = [&](double shortfall) {
-    if (shortfall <= 0) return 0;
-    const int cells = static_cast<int>(std::ceil(shortfall / res));
-    return (cells + block - 1) / block * block;
+    if (shortfall <= 0) return 0.0;
+    return std::ceil(std::ceil(shortfall / res) / block) * block;
   };
-  const int left = cells_needed(x0 - min_x), bottom = cells_needed(y0 - min_y);
-  const int right = cells_needed(max_x - x1 + res), top = cells_needed(max_y - y1 + res);
+  const double grown_w = map_.width() + cells_needed(x0 - min_x) + cells_needed(max_x - x1 + res);
+  const double grown_h = map_.height() + cells_needed(y0 - min_y) + cells_needed(max_y - y1 + res);
+  if (grown_w * grown_h > double(kMaxGridCells)) return false;
+  const int left = static_cast<int>(cells_needed(x0 - min_x)), bottom = static_cast<int>(cells_needed(y0 - min_y));
+  const int right = static_cast<int>(cells_needed(max_x - x1 + res));
+  const int top = static_cast<int>(cells_needed(max_y - y1 + res));
   OccupancyGrid grown(map_.width() + left + right, map_.height() + bottom + top, res, x0 - left * res,
                       y0 - bottom * res);
   for (int y = 0; y < map_.height(); ++y) {
@@ -43,7 +47,39 @@ void LogOddsMapper::EnsureCovers(double min_x, double min_y, double max_x, doubl
   }
   map_ = std::move(grown);
   ++grow_count_;
+  return true;
 }
+
+namespace {
+
+// Clips the segment (x0, y0)-(x1, y1) to the box (Liang–Barsky). False when none of it is inside.
+bool ClipSegment(double* x0, double* y0, double* x1, double* y1, double bx0, double by0, double bx1, double by1) {
+  const double dx = *x1 - *x0, dy = *y1 - *y0;
+  double t0 = 0.0, t1 = 1.0;
+  const double p[4] = {-dx, dx, -dy, dy};
+  const double q[4] = {*x0 - bx0, bx1 - *x0, *y0 - by0, by1 - *y0};
+  for (int i = 0; i < 4; ++i) {
+    if (p[i] == 0.0) {
+      if (q[i] < 0.0) return false;
+      continue;
+    }
+    const double t = q[i] / p[i];
+    if (p[i] < 0.0) {
+      t0 = std::max(t0, t);
+    } else {
+      t1 = std::min(t1, t);
+    }
+    if (t0 > t1) return false;
+  }
+  const double ox = *x0, oy = *y0;
+  *x0 = ox + t0 * dx;
+  *y0 = oy + t0 * dy;
+  *x1 = ox + t1 * dx;
+  *y1 = oy + t1 * dy;
+  return true;
+}
+
+}  // namespace
 
 void BresenhamLine(int x0, int y0, int x1, int y1, std::vector<int>* xs, std::vector<int>* ys) {
   xs->clear();
@@ -67,12 +103,17 @@ void BresenhamLine(int x0, int y0, int x1, int y1, std::vector<int>* xs, std::ve
   }
 }
 
-void LogOddsMapper::Insert(const std::vector<ScanRay>& rays, const motion::Pose2D& robot_pose) {
-  if (rays.empty()) return;
+bool LogOddsMapper::Insert(const std::vector<ScanRay>& rays, const motion::Pose2D& robot_pose) {
+  if (rays.empty()) return true;
+  if (!std::isfinite(robot_pose.x) || !std::isfinite(robot_pose.y) || !std::isfinite(robot_pose.theta)) {
+    ++rejected_scans_;
+    return false;
+  }
   const double c = std::cos(robot_pose.theta), s = std::sin(robot_pose.theta);
   struct WorldRay {
     double ox, oy, ex, ey;
     bool hit;
+    bool dropped = false;
   };
   std::vector<WorldRay> world(rays.size());
   double min_x = robot_pose.x, max_x = robot_pose.x, min_y = robot_pose.y, max_y = robot_pose.y;
@@ -84,16 +125,36 @@ void LogOddsMapper::Insert(const std::vector<ScanRay>& rays, const motion::Pose2
     w.ex = robot_pose.x + c * r.ex - s * r.ey;
     w.ey = robot_pose.y + s * r.ex + c * r.ey;
     w.hit = r.hit;
+    if (!std::isfinite(w.ox) || !std::isfinite(w.oy) || !std::isfinite(w.ex) || !std::isfinite(w.ey)) {
+      w = WorldRay{robot_pose.x, robot_pose.y, robot_pose.x, robot_pose.y, false, true};
+      continue;
+    }
     min_x = std::min({min_x, w.ox, w.ex});
     max_x = std::max({max_x, w.ox, w.ex});
     min_y = std::min({min_y, w.oy, w.ey});
     max_y = std::max({max_y, w.oy, w.ey});
   }
-  if (options_.grow) EnsureCovers(min_x, min_y, max_x, max_y);
+  if (options_.grow && !EnsureCovers(min_x, min_y, max_x, max_y)) {
+    ++rejected_scans_;
+    return false;
+  }
+  // Rays reaching far beyond the grid are clipped to a box around it (a grid's size on each side),
+  // so a corrupt range costs no more than a ray across the grid; nearer rays keep their own ends.
+  const double res = map_.resolution();
+  const double margin = std::max(map_.width(), map_.height()) * res;
+  const double bx0 = map_.origin_x() - margin, by0 = map_.origin_y() - margin;
+  const double bx1 = map_.origin_x() + map_.width() * res + margin;
+  const double by1 = map_.origin_y() + map_.height() * res + margin;
 
   const int hit = options_.hit_odds, miss = options_.miss_odds;
   std::vector<int> xs, ys;
-  for (const WorldRay& w : world) {
+  for (WorldRay& w : world) {
+    if (w.dropped) continue;
+    if (w.ox < bx0 || w.ox > bx1 || w.ex < bx0 || w.ex > bx1 || w.oy < by0 || w.oy > by1 || w.ey < by0 || w.ey > by1) {
+      const double ex = w.ex, ey = w.ey;
+      if (!ClipSegment(&w.ox, &w.oy, &w.ex, &w.ey, bx0, by0, bx1, by1)) continue;
+      if (w.ex != ex || w.ey != ey) w.hit = false;  // the end is beyond the box, never a cell of the grid
+    }
     int cx0, cy0, cx1, cy1;
     map_.WorldToCell(w.ox, w.oy, &cx0, &cy0);
     map_.WorldToCell(w.ex, w.ey, &cx1, &cy1);
@@ -107,6 +168,7 @@ void LogOddsMapper::Insert(const std::vector<ScanRay>& rays, const motion::Pose2
       cell = static_cast<int8_t>(v);
     }
   }
+  return true;
 }
 
 }  // namespace mbot::mapping

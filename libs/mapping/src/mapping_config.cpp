@@ -50,7 +50,7 @@ MapperOptions ParseMapperOptions(config::Section& s, const MapperOptions& defaul
   mp.center_y_m = s.GetDouble("center_y_m", mp.center_y_m, "initial map centre y", -1e6, 1e6);
   // The grid these ask for must be one a computer can hold (2^28 cells, as for map files).
   const double cells = std::ceil(mp.width_m / mp.resolution_m) * std::ceil(mp.height_m / mp.resolution_m);
-  if (cells > double(1LL << 28)) {
+  if (cells > double(kMaxGridCells)) {
     s.Fail("width_m", "a " + std::to_string(mp.width_m) + " x " + std::to_string(mp.height_m) + " m map at " +
                           std::to_string(mp.resolution_m) + " m is more than 2^28 cells");
   }

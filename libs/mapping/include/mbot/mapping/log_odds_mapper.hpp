@@ -20,7 +20,7 @@ struct MapperOptions {
   double height_m = 10.0;
   double center_x_m = 0.0;
   double center_y_m = 0.0;
-  bool grow = true;           // false: rays leaving the extent are clipped
+  bool grow = true;           // false: rays leaving the extent are clipped (never past kMaxGridCells)
   double grow_block_m = 5.0;  // the extent grows by multiples of this
 };
 
@@ -30,18 +30,22 @@ class LogOddsMapper {
   // Starts from an existing map (its extent and resolution replace the options').
   void Reset(OccupancyGrid map);
 
-  // Inserts rays given in the frame of `robot_pose` (see DeskewScan).
-  void Insert(const std::vector<ScanRay>& rays, const motion::Pose2D& robot_pose);
+  // Inserts rays given in the frame of `robot_pose` (see DeskewScan). Rays with a non-finite end are
+  // dropped; a scan that would grow the grid past kMaxGridCells (a corrupt range or pose) is not
+  // inserted and is counted in rejected_scans(). Returns whether the scan was inserted.
+  bool Insert(const std::vector<ScanRay>& rays, const motion::Pose2D& robot_pose);
 
   const OccupancyGrid& map() const { return map_; }
   int grow_count() const { return grow_count_; }
+  int rejected_scans() const { return rejected_scans_; }
 
  private:
-  void EnsureCovers(double min_x, double min_y, double max_x, double max_y);
+  bool EnsureCovers(double min_x, double min_y, double max_x, double max_y);
 
   MapperOptions options_;
   OccupancyGrid map_;
   int grow_count_ = 0;
+  int rejected_scans_ = 0;
 };
 
 // Cells on the segment between two cells, both ends included, in order (Bresenham).

@@ -8,6 +8,10 @@
 
 namespace mbot::mapping {
 
+// The most cells a grid may have (a 16,384 × 16,384 grid, 256 MB of int8): map files, config keys
+// and a growing map are all held to it.
+inline constexpr long long kMaxGridCells = 1LL << 28;
+
 class OccupancyGrid {
  public:
   OccupancyGrid() = default;
