@@ -1,5 +1,7 @@
 #include "mbot/drivers/source_options.hpp"
 
+#include "mbot/common/files.hpp"
+
 #include <zlib.h>
 
 #include <cmath>
@@ -214,7 +216,7 @@ std::string DetectFormat(const std::string& path) {
     if (t->detect_order >= 0 && !checked_file) {
       checked_file = true;
       if (std::filesystem::is_directory(path)) throw std::runtime_error(path + ": is a directory, not a dataset file");
-      if (!std::filesystem::is_regular_file(path)) throw std::runtime_error(path + ": no such file");
+      RequireReadableFile(path);  // "no such file", "permission denied", … rather than a guess at the format
     }
     if (t->detect(path)) return t->name;
   }
@@ -230,6 +232,7 @@ std::unique_ptr<Source> OpenSource(const SourceOptions& options) {
   if (type != "astar_cases" && type != "lcm_live" && std::filesystem::is_directory(options.path)) {
     throw std::runtime_error(options.path + ": is a directory, not a " + type + " file");
   }
+  if (type != "astar_cases" && type != "lcm_live" && !options.path.empty()) RequireReadableFile(options.path);
   return t->open(options);
 }
 
