@@ -78,6 +78,26 @@ TEST(CarmenSourceTest, NonFiniteNumbersAreRejectedWithTheirLine) {
   EXPECT_EQ(src->diagnostics().rejected_messages, 3);
 }
 
+// A count that does not describe its line leaves tokens over: the record is rejected, not half read.
+TEST(CarmenSourceTest, TokensBeyondTheRecordRejectIt) {
+  const auto path = test::TempPath("trailing.log");
+  std::ofstream(path) << "ODOM 1 2 0.5 0 0 0 1 host 1\n"
+                         "ODOM 1 2 0.5 0 0 0 2 host 2 extra\n"
+                         "FLASER 2 1.0 2.0 3.0 0 0 0 0 0 0 3 host 3\n"  // three ranges, count says two
+                         "ODOM 1 2 0.5 0 0 0 4\n";                      // no host or logger stamp: fine
+  SourceOptions o;
+  o.path = path;
+  auto src = OpenSource(o);
+  int odom = 0, lidar = 0;
+  while (auto e = src->Next()) {
+    odom += e->channel == "ODOM";
+    lidar += e->kind == EventKind::kLidar;
+  }
+  EXPECT_EQ(odom, 2);
+  EXPECT_EQ(lidar, 0);
+  EXPECT_EQ(src->diagnostics().rejected_messages, 2);
+}
+
 // Old Mac line ends (CR alone) and Windows ones (CRLF) read like LF: every record, numbered.
 TEST(CarmenSourceTest, EveryLineEndIsALineEnd) {
   for (const char* end : {"\r", "\r\n", "\n"}) {

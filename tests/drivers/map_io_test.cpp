@@ -1,12 +1,18 @@
 #include "mbot/drivers/map_io.hpp"
 
 #include <gtest/gtest.h>
+#include <mrpt/io/CFileOutputStream.h>
+#include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/serialization/CArchive.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose3DPDFGaussian.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <iterator>
 #include <fstream>
 #include <functional>
 
@@ -159,6 +165,83 @@ TEST(MapIoTest, SimplemapWithoutScansIsAnError) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(path + ": holds no 2D range scans"), std::string::npos) << e.what();
   }
+}
+
+// Replaces the first occurrence of `from` in the file with `to` (same length); false if absent.
+bool PatchBytes(const std::string& path, const std::vector<uint8_t>& from, const std::vector<uint8_t>& to) {
+  std::ifstream in(path, std::ios::binary);
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = std::search(bytes.begin(), bytes.end(), from.begin(), from.end());
+  if (at == bytes.end()) return false;
+  std::copy(to.begin(), to.end(), at);
+  test::WriteBytes(path, bytes);
+  return true;
+}
+
+std::vector<uint8_t> FloatBytes(float f) {
+  std::vector<uint8_t> b(4);
+  std::memcpy(b.data(), &f, 4);
+  return b;
+}
+
+// An MRPT gridmap whose resolution was changed from 0.05 to 1e-4 m declares 20,000 × 20,000 cells:
+// MRPT would allocate 800 MB for a file of a few kilobytes. It is refused in a bounded trial read.
+TEST(MapIoTest, MrptGridmapAskingForMoreThanItsSizeIsRefused) {
+  mrpt::maps::COccupancyGridMap2D grid(-1.0f, 1.0f, -1.0f, 1.0f, 0.05f);
+  const auto path = test::TempPath("huge.gridmap");
+  {
+    mrpt::io::CFileOutputStream out(path);  // uncompressed, so the resolution's bytes can be found
+    auto arch = mrpt::serialization::archiveFrom(out);
+    arch << grid;
+  }
+  EXPECT_EQ(ReadMrptGridmap(path).width(), 40);
+  ASSERT_TRUE(PatchBytes(path, FloatBytes(0.05f), FloatBytes(1e-4f)));
+  try {
+    ReadMrptGridmap(path);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind(path + ": cannot read MRPT gridmap: ", 0), 0u) << what;
+#if !defined(__SANITIZE_ADDRESS__)
+    EXPECT_NE(what.find("asks for more memory than the 256 MB its size allows"), std::string::npos) << what;
+#endif
+  }
+}
+
+TEST(MapIoTest, MrptExceptionsComeOutAsOneLineNamingTheFile) {
+  const auto path = test::TempPath("garbage.gridmap");
+  test::WriteBytes(path, {0x93, 'C', 'O', 'c', 'c', 'u', 'p', 'a', 'n',  'c', 'y', 'G',
+                          'r',  'i', 'd', 'M', 'a', 'p', '2', 'D', 0x7f, 1,   2,   3});
+  try {
+    ReadMrptGridmap(path);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind(path + ": cannot read MRPT gridmap: ", 0), 0u) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;  // no backtrace
+  }
+}
+
+TEST(MapIoTest, SimplemapScansWithCorruptRangesCannotGrowTheGridWithoutBound) {
+  mrpt::maps::CSimpleMap sm;
+  for (const float range : {2.0f, 1e30f}) {
+    auto scan = std::make_shared<mrpt::obs::CObservation2DRangeScan>();
+    scan->aperture = static_cast<float>(M_PI);
+    scan->maxRange = 1e31f;
+    scan->resizeScan(19);
+    for (size_t i = 0; i < 19; ++i) {
+      scan->setScanRange(i, range);
+      scan->setScanRangeValidity(i, true);
+    }
+    auto sf = std::make_shared<mrpt::obs::CSensoryFrame>();
+    sf->insert(scan);
+    sm.insert(std::make_shared<mrpt::poses::CPose3DPDFGaussian>(), sf);
+  }
+  const auto path = test::TempPath("far.simplemap");
+  ASSERT_TRUE(sm.saveToFile(path));
+  const mapping::OccupancyGrid g = ReadMrptSimplemap(path);
+  EXPECT_LE(static_cast<long long>(g.width()) * g.height(), kMaxMapCells);
+  EXPECT_LT(g.width(), 1000);  // the sane scan's map, the far one left out
 }
 
 TEST(MapIoTest, PngIsWritten) {

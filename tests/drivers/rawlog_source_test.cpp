@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 #include <iterator>
@@ -8,7 +9,9 @@
 
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservationOdometry.h>
+#include <mrpt/io/CFileOutputStream.h>
 #include <mrpt/obs/CRawlog.h>
+#include <mrpt/serialization/CArchive.h>
 
 #include "mbot/drivers/source_options.hpp"
 #include "test_util.hpp"
@@ -81,6 +84,44 @@ TEST(RawlogSourceTest, ARawlogCutShortIsReported) {
   while (src->Next()) ++n;
   EXPECT_GT(n, 0);
   EXPECT_LT(n, 200);
+  EXPECT_TRUE(src->diagnostics().truncated_tail);
+}
+
+// A scan whose beam count was changed to 2^31 - 1 makes MRPT's reader allocate 8 GB of aligned floats
+// and write through the null pointer it gets back when that fails. The trial read in a bounded child
+// finds the record; the entries before it are kept, like a file cut short.
+TEST(RawlogSourceTest, ARecordThatCrashesMrptsReaderEndsTheReadWithAWarning) {
+  const auto path = test::TempPath("crash.rawlog");
+  {
+    mrpt::io::CFileOutputStream out(path);  // uncompressed, so the count's bytes can be found
+    auto arch = mrpt::serialization::archiveFrom(out);
+    for (int i = 0; i < 6; ++i) {
+      mrpt::obs::CObservation2DRangeScan scan;
+      scan.sensorLabel = "LASER";
+      scan.timestamp = mrpt::Clock::fromDouble(1000.0 + i);
+      scan.aperture = M_PI;
+      scan.resizeScan(i == 3 ? 171 : 181);  // the fourth scan's count is the one to corrupt
+      for (size_t k = 0; k < scan.getScanSize(); ++k) scan.setScanRange(k, 2.0f);
+      arch << scan;
+    }
+  }
+  std::vector<uint8_t> bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::vector<uint8_t> count = {171, 0, 0, 0, 0, 0, 0, 0x40};  // 171, then the first range 2.0f
+  auto at = std::search(bytes.begin(), bytes.end(), count.begin(), count.end());
+  ASSERT_NE(at, bytes.end());
+  at[0] = 0xff, at[1] = 0xff, at[2] = 0xff, at[3] = 0x7f;
+  test::WriteBytes(path, bytes);
+
+  SourceOptions o;
+  o.path = path;
+  auto src = OpenSource(o);
+  int n = 0;
+  while (src->Next()) ++n;
+  EXPECT_EQ(n, 3);
   EXPECT_TRUE(src->diagnostics().truncated_tail);
 }
 

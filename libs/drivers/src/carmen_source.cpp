@@ -56,6 +56,14 @@ class Cursor {
     return static_cast<int>(v);
   }
   void Skip(size_t n = 1) { i_ += n; }
+  // After the timestamp a record carries the host name and the logger's timestamp, nothing more: more
+  // tokens mean the counts did not describe the line (a record glued to the next, or a wrong count).
+  void End() {
+    if (left() > 2) {
+      throw ParseError(std::to_string(left() - 2) + " tokens more than the record holds (after ipc_hostname and " +
+                       "logger_timestamp)");
+    }
+  }
   size_t left() const { return i_ < t_.size() ? t_.size() - i_ : 0; }
 
  private:
@@ -172,6 +180,7 @@ void CarmenSource::ParseLine(const std::string& line, int line_no) {
       const motion::Pose2D pose{c.Num("x"), c.Num("y"), c.Num("theta")};
       const motion::Pose2D odom{c.Num("odom_x"), c.Num("odom_y"), c.Num("odom_theta")};
       const int64_t ts = Micros(c.Num("ipc_timestamp"));
+      c.End();
       // The laser pose (corrected in these logs) and the odometry fields stay apart.
       events_.push_back(Event{ts, ts, name, EventKind::kLidar, std::move(scan)});
       events_.push_back(Event{ts, ts, name + ".pose", EventKind::kReferencePose, pose});
@@ -183,12 +192,14 @@ void CarmenSource::ParseLine(const std::string& line, int line_no) {
       const motion::Pose2D pose{c.Num("x"), c.Num("y"), c.Num("theta")};
       c.Skip(3);  // tv rv accel
       const int64_t ts = Micros(c.Num("ipc_timestamp"));
+      c.End();
       events_.push_back(Event{ts, ts, name, EventKind::kOdometry, pose});
       channel(name, "ODOM", EventKind::kOdometry);
     } else if (name == "TRUEPOS") {
       const motion::Pose2D truth{c.Num("true_x"), c.Num("true_y"), c.Num("true_theta")};
       c.Skip(3);
       const int64_t ts = Micros(c.Num("ipc_timestamp"));
+      c.End();
       events_.push_back(Event{ts, ts, name, EventKind::kGroundTruth, truth});
       channel(name, "TRUEPOS", EventKind::kGroundTruth);
     } else if (name.rfind("ROBOTLASER", 0) == 0 || name.rfind("RAWLASER", 0) == 0) {
@@ -217,19 +228,21 @@ void CarmenSource::ParseLine(const std::string& line, int line_no) {
         const motion::Pose2D robot_pose{c.Num("robot_x"), c.Num("robot_y"), c.Num("robot_theta")};
         c.Skip(5);  // tv rv forward_safety side_safety turn_axis
         ts = Micros(c.Num("timestamp"));
+        c.End();
         // Sensor offset on the robot, from the two poses the line gives.
         scan.sensor_pose = robot_pose.Inverse().Compose(laser);
         events_.push_back(Event{ts, ts, name + ".pose", EventKind::kReferencePose, robot_pose});
         channel(name + ".pose", "robot pose fields", EventKind::kReferencePose);
       } else {
         ts = Micros(c.Num("timestamp"));
+        c.End();
       }
       events_.push_back(Event{ts, ts, name, EventKind::kLidar, std::move(scan)});
       channel(name, robot ? "ROBOTLASER" : "RAWLASER", EventKind::kLidar);
     } else if (name == "PARAM") {
       if (t.size() >= 3 && t[1] == "robot_front_laser_max") {
         max_range_m_ = std::strtod(t[2].c_str(), nullptr);
-        if (!(max_range_m_ > 0)) max_range_m_ = options_.carmen_max_range_m;
+        if (!(max_range_m_ > 0 && max_range_m_ <= 1e4)) max_range_m_ = options_.carmen_max_range_m;
       }
       ++ignored_lines_;
     } else {

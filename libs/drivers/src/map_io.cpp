@@ -19,8 +19,11 @@
 #include <stdexcept>
 
 #include "mbot/common/atomic_file.hpp"
+#include "mbot/common/files.hpp"
+#include "mbot/common/log.hpp"
 #include "mbot/common/strings.hpp"
 #include "mbot/mapping/log_odds_mapper.hpp"
+#include "mrpt_read.hpp"
 #include "mrpt_scan.hpp"
 
 namespace fs = std::filesystem;
@@ -62,9 +65,21 @@ void CheckFrame(const std::string& path, const std::string& where, double ox, do
     Fail(path, where + " resolution " + ShortestDouble(res) + " is not in [1e-4, 100] m");
 }
 
-// A PGM image's declared size (P2 text or P5 binary), checked before OpenCV allocates it.
-void CheckPgmHeader(const std::string& path) {
+// A map image's declared size (PGM P2 text or P5 binary, or PNG), checked before OpenCV allocates it.
+void CheckImageHeader(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
+  unsigned char png[24] = {};
+  if (in.read(reinterpret_cast<char*>(png), sizeof png) && png[0] == 0x89 && png[1] == 'P' && png[2] == 'N' &&
+      png[3] == 'G') {
+    auto be32 = [&](int at) {
+      return (long long)png[at] << 24 | (long long)png[at + 1] << 16 | (long long)png[at + 2] << 8 | png[at + 3];
+    };
+    // A PNG compresses well, so only the cell limit applies (not the file's size).
+    CheckDeclaredCells(path, "PNG header: width x height", be32(16), be32(20), 0.0);
+    return;
+  }
+  in.clear();
+  in.seekg(0);
   std::string magic;
   if (!(in >> magic) || (magic != "P5" && magic != "P2")) return;  // another image format: OpenCV's to judge
   long long v[3];
@@ -176,9 +191,16 @@ mapping::OccupancyGrid ReadRosMap(const std::string& yaml_path) {
   if (mode != "trinary" && mode != "scale") Fail(yaml_path, "mode '" + mode + "' is not supported (trinary, scale)");
   CheckFrame(yaml_path, "", ox, oy, res);
   const fs::path img_path = fs::path(image).is_absolute() ? fs::path(image) : fs::path(yaml_path).parent_path() / image;
-  CheckPgmHeader(img_path.string());
-  cv::Mat img = cv::imread(img_path.string(), cv::IMREAD_GRAYSCALE);
+  CheckImageHeader(img_path.string());
+  RequireReadableFile(img_path.string());
+  cv::Mat img;
+  try {
+    img = cv::imread(img_path.string(), cv::IMREAD_GRAYSCALE);
+  } catch (const cv::Exception& e) {  // e.g. an image larger than OpenCV's CV_IO_MAX_IMAGE_PIXELS
+    Fail(img_path.string(), "cannot read map image (named in " + yaml_path + "): " + e.err);
+  }
   if (img.empty()) Fail(img_path.string(), "cannot read map image (named in " + yaml_path + ")");
+  CheckDeclaredCells(img_path.string(), "image width x height", img.cols, img.rows, 0.0);
   mapping::OccupancyGrid grid(img.cols, img.rows, res, ox, oy);
   for (int r = 0; r < img.rows; ++r) {
     const uint8_t* row = img.ptr<uint8_t>(r);
@@ -222,17 +244,16 @@ void WriteRosMap(const mapping::OccupancyGrid& g, const std::string& yaml_path) 
 
 mapping::OccupancyGrid ReadMrptGridmap(const std::string& path) {
   mrpt::maps::COccupancyGridMap2D m;
-  try {
+  ReadMrptFile(path, "MRPT gridmap", [&] {
     mrpt::io::CFileGZInputStream f(path);
     auto arch = mrpt::serialization::archiveFrom(f);
     auto obj = arch.ReadObject();
     auto grid = std::dynamic_pointer_cast<mrpt::maps::COccupancyGridMap2D>(obj);
     if (!grid) Fail(path, std::string("holds a ") + obj->GetRuntimeClass()->className + ", not a COccupancyGridMap2D");
     m = *grid;
-  } catch (const std::runtime_error& e) {
-    if (std::string(e.what()).rfind(path, 0) == 0) throw;
-    Fail(path, std::string("cannot read MRPT gridmap: ") + e.what());
-  }
+  });
+  CheckDeclaredCells(path, "grid size_x x size_y", m.getSizeX(), m.getSizeY(), 0.0);
+  CheckFrame(path, "grid", m.getXMin(), m.getYMin(), m.getResolution());
   mapping::OccupancyGrid out(static_cast<int>(m.getSizeX()), static_cast<int>(m.getSizeY()), m.getResolution(),
                              m.getXMin(), m.getYMin());
   for (int y = 0; y < out.height(); ++y) {
@@ -245,14 +266,10 @@ mapping::OccupancyGrid ReadMrptGridmap(const std::string& path) {
 }
 
 mapping::OccupancyGrid ReadMrptSimplemap(const std::string& path, double resolution_m) {
-  if (!fs::is_regular_file(path)) Fail(path, "no such file");
   mrpt::maps::CSimpleMap sm;
-  try {
+  ReadMrptFile(path, "MRPT simplemap", [&] {
     if (!sm.loadFromFile(path)) Fail(path, "cannot read MRPT simplemap");
-  } catch (const std::runtime_error& e) {
-    if (std::string(e.what()).rfind(path, 0) == 0) throw;
-    Fail(path, std::string("cannot read MRPT simplemap: ") + e.what());
-  }
+  });
   mapping::MapperOptions options;
   options.resolution_m = resolution_m;
   for (size_t k = 0; k < sm.size(); ++k) {  // start the extent around the first keyframe
@@ -283,6 +300,15 @@ mapping::OccupancyGrid ReadMrptSimplemap(const std::string& path, double resolut
   }
   if (scans == 0)
     Fail(path, "holds no 2D range scans to build a grid from (" + std::to_string(sm.size()) + " keyframes)");
+  if (mapper.rejected_scans() == static_cast<int>(scans)) {
+    Fail(path, "none of its " + std::to_string(scans) + " scans could be inserted (non-finite poses or ranges " +
+                   "that would grow the grid past " + std::to_string(kMaxMapCells) + " cells)");
+  }
+  if (mapper.rejected_scans() > 0) {
+    mbot::log::Warn(path + ": " + std::to_string(mapper.rejected_scans()) + " of " + std::to_string(scans) +
+                    " scans left out (non-finite poses or ranges that would grow the grid past " +
+                    std::to_string(kMaxMapCells) + " cells)");
+  }
   return mapper.map();
 }
 
@@ -404,6 +430,7 @@ bool IsMapFile(const std::string& path) {
 }
 
 mapping::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format) {
+  RequireReadableFile(path);
   auto set = [&](const char* f) {
     if (format) *format = f;
   };

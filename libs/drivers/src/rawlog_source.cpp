@@ -14,35 +14,36 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "mbot/common/files.hpp"
 #include "mbot/common/log.hpp"
+#include "mrpt_read.hpp"
 #include "mrpt_scan.hpp"
 
 namespace mbot::drivers {
 namespace {
 
-// The line of an MRPT exception that says what happened (its text after "Message:"), else its first.
-std::string MrptMessage(const std::string& what) {
-  const size_t m = what.find("Message:");
-  const size_t b = m == std::string::npos ? 0 : what.find_first_not_of(' ', m + 8);
-  const std::string line = what.substr(b == std::string::npos ? 0 : b);
-  return line.substr(0, line.find('\n'));
-}
-
 // The rawlog's entries, as MRPT's CRawlog::loadFromRawLogFile reads them (one CRawlog object, or a
 // sequence of sensory frames, action collections and observations) — except that a record cut short
-// is reported in *cut instead of ending the read quietly. False when the file cannot be opened.
-bool LoadRawlog(const std::string& path, mrpt::obs::CRawlog* rawlog, std::string* cut) {
+// is reported in *cut instead of ending the read quietly. Reads at most `max_records` records and
+// counts them in *records. False when the file cannot be opened.
+bool LoadRawlog(const std::string& path, mrpt::obs::CRawlog* rawlog, std::string* cut, uint64_t* records,
+                uint64_t max_records) {
   mrpt::io::CFileGZInputStream fs;
   if (!fs.open(path)) return false;
   auto arch = mrpt::serialization::archiveFrom(fs);
-  for (;;) {
+  for (;; ++*records) {
+    if (*records >= max_records) return true;
     mrpt::serialization::CSerializable::Ptr obj;
     try {
       obj = arch.ReadObject();
     } catch (const mrpt::serialization::CExceptionEOF&) {
       return true;  // the end, at a record boundary
+    } catch (const std::bad_alloc&) {
+      throw;  // the trial read reports it with the record's number
     } catch (const std::exception& e) {
-      *cut = "a record it could not read (" + MrptMessage(e.what()) + ")";
+      const std::string why = MrptReason(e.what());
+      if (why.find("bad_alloc") != std::string::npos) throw std::bad_alloc();
+      *cut = "a record it could not read (" + why + ")";
       return true;
     }
     if (auto whole = std::dynamic_pointer_cast<mrpt::obs::CRawlog>(obj)) {
@@ -77,15 +78,24 @@ std::string Label(const mrpt::obs::CObservation& obs) {
 }  // namespace
 
 RawlogSource::RawlogSource(const SourceOptions& options) {
-  if (!std::filesystem::is_regular_file(options.path)) throw std::runtime_error(options.path + ": no such file");
   mrpt::obs::CRawlog rawlog;
   std::string cut;
   bool ok = false;
+  RequireReadableFile(options.path);
+  // A record that crashes MRPT's reader or asks for more memory than the file could need is found in
+  // a child first; the records before it are kept, like a file cut short.
+  const MrptTrial trial = TrialReadMrpt(options.path, [&](uint64_t* records) {
+    mrpt::obs::CRawlog scratch;
+    std::string scratch_cut;
+    LoadRawlog(options.path, &scratch, &scratch_cut, records, UINT64_MAX);
+  });
+  uint64_t records = 0;
   try {
-    ok = LoadRawlog(options.path, &rawlog, &cut);
+    ok = LoadRawlog(options.path, &rawlog, &cut, &records, trial.ok ? UINT64_MAX : trial.records);
   } catch (const std::exception& e) {
-    throw std::runtime_error(options.path + ": cannot read MRPT rawlog: " + MrptMessage(e.what()));
+    throw std::runtime_error(options.path + ": cannot read MRPT rawlog: " + MrptReason(e.what()));
   }
+  if (!trial.ok) cut = "record " + std::to_string(trial.records + 1) + ": " + trial.reason;
   if (!ok) throw std::runtime_error(options.path + ": cannot read MRPT rawlog");
   if (!cut.empty()) {
     diagnostics_.truncated_tail = true;

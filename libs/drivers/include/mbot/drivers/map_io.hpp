@@ -18,7 +18,7 @@ namespace mbot::drivers {
 // of int8), no more cells than the file's bytes can hold (a text map spends at least one byte per
 // cell, a binary PGM exactly one), origins within ±1e6 m and a resolution in [1e-4, 100] m. A header
 // beyond them is an error naming the file, the field and the value, before anything is allocated.
-inline constexpr long long kMaxMapCells = 1LL << 28;
+inline constexpr long long kMaxMapCells = mapping::kMaxGridCells;
 
 mapping::OccupancyGrid ReadBotlabMap(const std::string& path);
 void WriteBotlabMap(const mapping::OccupancyGrid& grid, const std::string& path);
