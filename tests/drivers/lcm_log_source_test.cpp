@@ -157,6 +157,23 @@ TEST(LcmLogSourceTest, SlightlyOutOfOrderRecordsAreResorted) {
   EXPECT_EQ(ev[2].t_us, 3000);
 }
 
+// Found by fuzz_lcm_log: a record stamped near INT64_MIN made the reorder window's subtraction
+// overflow. Stamps outside 1970…2100 are rejected at the edge, like lcm_live does on the bus.
+TEST(LcmLogSourceTest, AbsurdRecordStampsAreRejected) {
+  std::vector<uint8_t> b;
+  AppendLcmRecord(b, 0, 1000, "ODOMETRY", test::Encode(Pose(0, 0, 0)));
+  AppendLcmRecord(b, 1, INT64_MIN + 7, "ODOMETRY", test::Encode(Pose(1, 0, 0)));
+  AppendLcmRecord(b, 2, -5, "ODOMETRY", test::Encode(Pose(1, 0, 0)));
+  AppendLcmRecord(b, 3, 2000, "ODOMETRY", test::Encode(Pose(2, 0, 0)));
+  const auto path = test::TempPath("absurd_stamps.log");
+  test::WriteBytes(path, b);
+  SourceDiagnostics diag;
+  const auto ev = ReadAll(path, &diag);
+  ASSERT_EQ(ev.size(), 2u);
+  EXPECT_EQ(ev[1].t_us, 2000);
+  EXPECT_EQ(diag.rejected_messages, 2);
+}
+
 TEST(LcmLogSourceTest, RandomCorruptionNeverCrashes) {
   std::vector<uint8_t> clean;
   for (int i = 0; i < 50; ++i) {

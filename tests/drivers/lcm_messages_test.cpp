@@ -78,6 +78,26 @@ TEST(LcmMessages, SlamStatusCarriesTheMode) {
   EXPECT_EQ(type->type, "slam_status_t");
 }
 
+// Found by fuzz_lcm_messages: a string length of INT32_MIN made lcm-gen's decoder compute
+// `length - 1` (signed overflow); 0 asked std::string for SIZE_MAX bytes. Both are rejected first.
+TEST(LcmMessages, StringLengthsAreCheckedBeforeLcmGenDecodes) {
+  std::vector<uint8_t> bytes;
+  ASSERT_TRUE(lcm_adapter::Encode(
+      Event{0, 1, "SLAM_STATUS", EventKind::kSlamStatus,
+            mapping::SlamStatus{mapping::SlamState::kLocalized, mapping::SlamMode::kLocalization, 0.1}},
+      &bytes));
+  ASSERT_GE(bytes.size(), 24u);
+  for (const std::vector<uint8_t>& length : {std::vector<uint8_t>{0x80, 0, 0, 0}, std::vector<uint8_t>{0, 0, 0, 0},
+                                             std::vector<uint8_t>{0x7f, 0xff, 0xff, 0xff}}) {
+    std::vector<uint8_t> bad = bytes;
+    std::copy(length.begin(), length.end(), bad.begin() + 20);
+    Event ev;
+    std::string error;
+    EXPECT_FALSE(lcm_adapter::Decode("SLAM_STATUS", bad.data(), bad.size(), ChannelRoles{}, &ev, &error));
+    EXPECT_NE(error.find("map_path length"), std::string::npos) << error;
+  }
+}
+
 TEST(LcmMessages, OdometryPoseRoundTrips) {
   const Event out = RoundTrip(Event{0, 7, "MBOT_ODOMETRY", EventKind::kOdometry, motion::Pose2D{1.5, -2.0, 0.75}});
   ASSERT_EQ(out.kind, EventKind::kOdometry);

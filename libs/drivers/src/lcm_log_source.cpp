@@ -50,6 +50,16 @@ std::optional<Event> LcmLogSource::ReadOne() {
                       std::to_string(rec->event_number) + ", byte " + std::to_string(rec->file_offset) + "): " + error);
       continue;
     }
+    // The logger's stamp and the message's utime are µs since the epoch (or the robot's boot): below
+    // zero or beyond 2100 they are garbage, rejected here like lcm_live does on the bus.
+    if (!IsPlausibleTimeUs(rec->timestamp_us) || !IsPlausibleTimeUs(ev.stamp_us)) {
+      ++diagnostics_.rejected_messages;
+      mbot::log::Warn(options_.path + ": rejected message on channel " + rec->channel + " (event " +
+                      std::to_string(rec->event_number) + ", byte " + std::to_string(rec->file_offset) +
+                      "): absurd timestamp (log " + std::to_string(rec->timestamp_us) + " us, utime " +
+                      std::to_string(ev.stamp_us) + " us)");
+      continue;
+    }
     info.kind = ev.kind;
     if (ev.kind == EventKind::kGroundTruth &&
         std::find(options_.roles.rezero_ground_truth.begin(), options_.roles.rezero_ground_truth.end(), rec->channel) !=

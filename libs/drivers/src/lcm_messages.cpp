@@ -68,6 +68,22 @@ bool CheckCount(const uint8_t* data, size_t size, size_t offset, size_t element_
   return true;
 }
 
+// Checks the int32 length of a string at `offset` (lcm-gen counts the closing NUL, so at least 1)
+// against the bytes left: lcm-gen's decoder computes `length - 1` and would overflow on INT32_MIN.
+bool CheckString(const uint8_t* data, size_t size, size_t offset, const char* field, std::string* error) {
+  if (size < offset + 4) {
+    *error = "message too short (" + std::to_string(size) + " bytes) to hold " + field;
+    return false;
+  }
+  const int32_t n = ReadI32(data + offset);
+  if (n < 1 || uint64_t(n) > size - offset - 4) {
+    *error = std::string(field) + " length " + std::to_string(n) + " disagrees with the payload (" +
+             std::to_string(size) + " bytes)";
+    return false;
+  }
+  return true;
+}
+
 // Runs the lcm-gen decoder and insists it consumed exactly the payload.
 template <typename T>
 bool DecodeExact(const uint8_t* data, size_t size, T* msg, std::string* error) {
@@ -172,6 +188,16 @@ Decoder Other(size_t count_offset = 0, size_t element_bytes = 0, const char* fie
     ev->kind = EventKind::kOther;
     ev->stamp_us = n >= 16 ? Fingerprint(d + 8, 8) : 0;  // every such type starts with utime
     return true;
+  };
+}
+
+// A message of no interest whose one string (its length at `string_offset`) is checked first.
+template <typename T>
+Decoder OtherWithString(size_t string_offset, const char* field) {
+  return [=](const std::string& channel, const uint8_t* d, size_t n, const ChannelRoles& roles, Event* ev,
+             std::string* err) {
+    if (!CheckString(d, n, string_offset, field, err)) return false;
+    return Other<T>()(channel, d, n, roles, ev, err);
   };
 }
 
@@ -360,6 +386,7 @@ std::map<int64_t, Entry> BuildTable() {
   add(mbot_w23::occupancy_grid_t::getHash(), "occupancy_grid_t", kW23,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
         // num_cells is followed by slam_mode and a string before the cells: check against the rest.
+        if (!CheckString(d, n, 48, "slam_map_location", err)) return false;
         return DecodeGrid<mbot_w23::occupancy_grid_t>(d, n, 36, ev, err);
       });
 
@@ -390,7 +417,7 @@ std::map<int64_t, Entry> BuildTable() {
   add(mbot_legacy::timestamp_t::getHash(), "timestamp_t", kW23, nullptr);
   add(mbot_legacy::timestamp_t::getHash(), "timestamp_t", kCurrent, nullptr);
   add(mbot_legacy::message_received_t::getHash(), "message_received_t", kLegacy,
-      Other<mbot_legacy::message_received_t>());
+      OtherWithString<mbot_legacy::message_received_t>(24, "channel"));
   add(mbot_legacy::message_received_t::getHash(), "mbot_message_received_t", kCurrent, nullptr);
   add(mbot_legacy::exploration_status_t::getHash(), "exploration_status_t", kLegacy,
       Other<mbot_legacy::exploration_status_t>());
@@ -409,9 +436,10 @@ std::map<int64_t, Entry> BuildTable() {
         ev->payload = mission::MissionStatus{kExplorationStates[m.state], kExplorationStatuses[m.status]};
         return true;
       });
-  add(mbot_lcm_msgs::slam_status_t::getHash(), "slam_status_t", kCurrent, Other<mbot_lcm_msgs::slam_status_t>());
+  add(mbot_lcm_msgs::slam_status_t::getHash(), "slam_status_t", kCurrent,
+      OtherWithString<mbot_lcm_msgs::slam_status_t>(20, "map_path"));
   add(mbot_lcm_msgs::mbot_slam_reset_t::getHash(), "mbot_slam_reset_t", kCurrent,
-      Other<mbot_lcm_msgs::mbot_slam_reset_t>());
+      OtherWithString<mbot_lcm_msgs::mbot_slam_reset_t>(20, "slam_map_location"));
   add(mbot_w23::mbot_system_reset_t::getHash(), "mbot_system_reset_t", kW23, nullptr);
   return t;
 }
