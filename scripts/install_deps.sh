@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages mbot_nav builds on. Safe to run twice: it only installs what is
 # missing, and does nothing (not even `apt-get update`) when everything is already there.
+#   scripts/install_deps.sh           what the build, the tests and the sanitizer build need
+#   scripts/install_deps.sh --fuzz    also clang and its libFuzzer runtime (scripts/fuzz.sh)
 set -euo pipefail
 
 packages=(
@@ -13,6 +15,13 @@ packages=(
   clang-format  # scripts/check_format.sh (ctest format.check)
   iproute2    # the live LCM tests set up loopback multicast in a private network namespace
 )
+
+if [ "${1:-}" = --fuzz ]; then
+  packages+=(clang libclang-rt-14-dev libomp-14-dev)
+elif [ $# -gt 0 ]; then
+  echo "install_deps: unknown argument '$1' (only --fuzz)" >&2
+  exit 2
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -22,6 +22,9 @@
 #define MBOT_ASAN 1
 #endif
 #endif
+#ifdef MBOT_ASAN
+#include <sanitizer/common_interface_defs.h>
+#endif
 
 namespace mbot::drivers {
 namespace {
@@ -34,9 +37,15 @@ uint64_t AddressSpaceBytes() {
   return pages * static_cast<uint64_t>(sysconf(_SC_PAGESIZE));
 }
 
-// Child side: bound the address space to what it maps now plus `budget`.
+// Child side: a crash or an allocation failure ends the child quietly (the parent reports it), and
+// the address space is bounded to what it maps now plus `budget`. Under AddressSanitizer (and a
+// fuzzer) the sanitizer's and the fuzzer's crash handlers are taken off first: the child's death is
+// the expected outcome of a bad file, not a finding.
 void BoundAddressSpace(uint64_t budget) {
-#ifndef MBOT_ASAN
+  for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) std::signal(sig, SIG_DFL);
+#ifdef MBOT_ASAN
+  __sanitizer_set_death_callback(nullptr);
+#endif
   const uint64_t now = AddressSpaceBytes();
   rlimit lim{};
   if (now == 0 || getrlimit(RLIMIT_AS, &lim) != 0) return;
@@ -44,9 +53,6 @@ void BoundAddressSpace(uint64_t budget) {
   if (lim.rlim_cur != RLIM_INFINITY && lim.rlim_cur <= want) return;
   lim.rlim_cur = want;
   setrlimit(RLIMIT_AS, &lim);
-#else
-  (void)budget;
-#endif
 }
 
 std::string MemoryReason(uint64_t budget) {

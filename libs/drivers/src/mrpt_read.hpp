@@ -24,8 +24,7 @@ struct MrptTrial {
   uint64_t records = 0;
 };
 
-// Runs `read(&records)` in a forked child bounded by MrptReadBudget of the file's size (the bound is
-// not applied under AddressSanitizer, which reserves terabytes of address space of its own).
+// Runs `read(&records)` in a forked child bounded by MrptReadBudget of the file's size.
 MrptTrial TrialReadMrpt(const std::string& path, const std::function<void(uint64_t* records)>& read);
 
 // Checks the file is readable, runs the trial, then `read` for real. Throws std::runtime_error
