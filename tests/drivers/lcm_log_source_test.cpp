@@ -158,7 +158,7 @@ TEST(LcmLogSourceTest, SlightlyOutOfOrderRecordsAreResorted) {
 }
 
 // Found by fuzz_lcm_log: a record stamped near INT64_MIN made the reorder window's subtraction
-// overflow. Stamps outside 1970…2100 are rejected at the edge, like lcm_live does on the bus.
+// overflow. Log stamps outside 1970…2100 are rejected at the edge, like lcm_live does on the bus.
 TEST(LcmLogSourceTest, AbsurdRecordStampsAreRejected) {
   std::vector<uint8_t> b;
   AppendLcmRecord(b, 0, 1000, "ODOMETRY", test::Encode(Pose(0, 0, 0)));

@@ -50,15 +50,22 @@ std::optional<Event> LcmLogSource::ReadOne() {
                       std::to_string(rec->event_number) + ", byte " + std::to_string(rec->file_offset) + "): " + error);
       continue;
     }
-    // The logger's stamp and the message's utime are µs since the epoch (or the robot's boot): below
-    // zero or beyond 2100 they are garbage, rejected here like lcm_live does on the bus.
-    if (!IsPlausibleTimeUs(rec->timestamp_us) || !IsPlausibleTimeUs(ev.stamp_us)) {
+    // The logger's stamp is µs since the epoch: below zero or beyond 2100 it is garbage, and the
+    // record is rejected (as lcm_live rejects such a utime on the bus). A message's own utime is
+    // garbage in some real logs (the 2017 staff SLAM_MAP): the message is kept, on the log's time.
+    if (!IsPlausibleTimeUs(rec->timestamp_us)) {
       ++diagnostics_.rejected_messages;
       mbot::log::Warn(options_.path + ": rejected message on channel " + rec->channel + " (event " +
                       std::to_string(rec->event_number) + ", byte " + std::to_string(rec->file_offset) +
-                      "): absurd timestamp (log " + std::to_string(rec->timestamp_us) + " us, utime " +
-                      std::to_string(ev.stamp_us) + " us)");
+                      "): absurd log timestamp " + std::to_string(rec->timestamp_us) + " us");
       continue;
+    }
+    if (!IsPlausibleTimeUs(ev.stamp_us)) {
+      mbot::log::WarnOnce(options_.path + ":utime:" + rec->channel,
+                          options_.path + ": channel " + rec->channel + " has absurd utime values (" +
+                              std::to_string(ev.stamp_us) + " us at event " + std::to_string(rec->event_number) +
+                              "); those messages take the log's time");
+      ev.stamp_us = rec->timestamp_us;
     }
     info.kind = ev.kind;
     if (ev.kind == EventKind::kGroundTruth &&
