@@ -243,6 +243,11 @@ struct SimRobot::Impl {
     out->push_back(MakeEvent(now, sim_channel::kEncoders, EventKind::kEncoders, EncoderTicks{tl, tr, dl, dr, fw_us}));
     out->push_back(MakeEvent(now, sim_channel::kMotorVel, EventKind::kWheelSpeed, WheelSpeeds{wl, wr}));
     out->push_back(MakeEvent(now, sim_channel::kOdometry, EventKind::kOdometry, odometry.AddEncoders(now, tl, tr)));
+    // Like the MBot firmware, the robot stops when no velocity command came for the timeout (an
+    // autonomy that died or a link that went quiet does not leave it driving).
+    if (o.command_timeout_s > 0 && now - last_command_us > static_cast<int64_t>(o.command_timeout_s * 1e6)) {
+      cmd_v = cmd_w = 0.0;
+    }
     const motion::WheelDuties duties = controller.Update(cmd_v, cmd_w, wl, wr);
     duty_l = duties.left;
     duty_r = duties.right;
@@ -300,6 +305,7 @@ struct SimRobot::Impl {
   // Truth.
   Pose2D pose;
   double cmd_v = 0.0, cmd_w = 0.0;
+  int64_t last_command_us = 0;
   double duty_l = 0.0, duty_r = 0.0;     // what the firmware sent last
   double w_l = 0.0, w_r = 0.0;           // wheel rotational speeds [rad/s]
   double angle_l = 0.0, angle_r = 0.0;   // cumulative wheel rotation [rad]
@@ -329,6 +335,7 @@ SimRobot::~SimRobot() = default;
 void SimRobot::Command(double v_m_s, double w_rad_s) {
   impl_->cmd_v = std::isfinite(v_m_s) ? v_m_s : 0.0;
   impl_->cmd_w = std::isfinite(w_rad_s) ? w_rad_s : 0.0;
+  impl_->last_command_us = impl_->now;
 }
 
 void SimRobot::AdvanceTo(int64_t t_us, std::vector<Event>* out) { impl_->AdvanceTo(t_us, out); }

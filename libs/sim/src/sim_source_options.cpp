@@ -62,6 +62,10 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& wo
                       "messages [Hz]"),
                   5.0, 1000.0);
   r.controller.dt_s = 1.0 / firmware_rate_hz;
+  r.command_timeout_s = s.GetDouble("command_timeout_s", r.command_timeout_s,
+                                    doc("the firmware stops the motors after this long without a velocity command "
+                                        "(0: never) [s]"),
+                                    0.0, 1e4);
   r.ground_truth_rate_hz = s.GetDouble("ground_truth_rate_hz", r.ground_truth_rate_hz,
                                        doc("rate of the TRUE_POSE messages [Hz]"), 1.0, 1000.0);
 

@@ -84,6 +84,7 @@ struct SimRobotOptions {
   double slip_stddev = 0.02;                      // relative ground-speed noise of each wheel (slip)
   double slip_interval_s = 0.05;                  // the slip of each wheel is redrawn this often (not white)
   double physics_dt_s = 0.002;
+  double command_timeout_s = 1.0;  // the firmware stops the motors after this long without a command (0: never)
   // A contact ends (and the next one counts again) once the footprint grown by this much is clear.
   double contact_release_m = 0.01;
   double ground_truth_rate_hz = 100.0;
