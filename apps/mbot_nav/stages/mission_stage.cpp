@@ -57,7 +57,8 @@ class MissionStage : public Stage {
       << ",\n  \"detail\": " << JsonString(r.status.detail)
       << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"commands\": " << r.commands
       << ",\n  \"paths\": " << r.paths << ",\n  \"stale_pose_stops\": " << r.stale_pose_stops
-      << ",\n  \"corrections\": " << r.corrections << ",\n  \"stall_recoveries\": " << r.stall_recoveries;
+      << ",\n  \"corrections\": " << r.corrections << ",\n  \"stall_recoveries\": " << r.stall_recoveries
+      << ",\n  \"odometry_restarts\": " << r.odometry_restarts;
     if (r.task == mission::TaskKind::kWarehouse)
       j << ",\n  \"stops\": " << r.stops << ",\n  \"stops_done\": " << r.stops_done;
     j << "\n}\n";

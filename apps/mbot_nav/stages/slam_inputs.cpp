@@ -102,10 +102,18 @@ bool SlamInputs::Accept(std::string* chosen, const std::string& wanted, const dr
   return false;
 }
 
-// Odometry as the filter sees it: with the configured perturbations (noise, a kidnapping jump).
+// Odometry as the filter sees it: continuous across robot restarts, then with the configured
+// perturbations (noise, a kidnapping jump).
 void SlamInputs::AddOdometry(int64_t t_us, const Pose2D& raw) {
-  const Pose2D out = perturbation_.Apply(t_us, first_t_us_, raw);
   if (!odometry_.empty() && t_us < odometry_.back().t_us) return;
+  const int restarts = continuity_.restarts();
+  const Pose2D continuous = continuity_.Update(t_us, raw);
+  if (continuity_.restarts() > restarts) {
+    mbot::log::Warn("slam: odometry jumped by more than a robot can move at " +
+                    std::to_string((t_us - first_t_us_) * 1e-6) +
+                    " s (a robot restart?): continuing from the pose before the jump");
+  }
+  const Pose2D out = perturbation_.Apply(t_us, first_t_us_, continuous);
   odometry_.push_back({t_us, out});
 }
 

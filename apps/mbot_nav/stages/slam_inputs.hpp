@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "mbot/drivers/events.hpp"
+#include "mbot/motion/odometry_continuity.hpp"
 #include "mbot/motion/odometry_perturbation.hpp"
 #include "mbot/motion/wheel_odometry.hpp"
 #include "slam_config.hpp"
@@ -48,6 +49,7 @@ class SlamInputs {
   int64_t last_t_us() const { return last_t_us_; }
   const std::string& lidar_channel() const { return lidar_channel_; }
   int64_t kidnapped_at_us() const { return perturbation_.kidnapped_at_us(); }
+  int odometry_restarts() const { return continuity_.restarts(); }
 
  private:
   const drivers::Event& Retime(const drivers::Event& ev, drivers::Event* copy);
@@ -55,6 +57,7 @@ class SlamInputs {
   void AddOdometry(int64_t t_us, const motion::Pose2D& raw);
 
   const SlamStageOptions& o_;
+  motion::OdometryContinuity continuity_;
   motion::OdometryPerturbation perturbation_;
   std::optional<motion::WheelOdometry> wheel_odometry_;
   std::string odometry_channel_, encoder_channel_, truth_channel_, reference_channel_, lidar_channel_;

@@ -55,15 +55,17 @@ MissionReport Mission::Report() const {
   r.status = status_;
   r.commands = commands_, r.paths = paths_, r.stale_pose_stops = stale_stops_;
   r.corrections = total_corrections_, r.stall_recoveries = recoveries_;
+  r.odometry_restarts = continuity_.restarts();
   task_->AddToReport(&r);
   return r;
 }
 
-std::vector<MissionOutput> Mission::OnOdometry(int64_t t_us, const Pose2D& odometry) {
+std::vector<MissionOutput> Mission::OnOdometry(int64_t t_us, const Pose2D& raw_odometry) {
   std::vector<MissionOutput> out;
   out_ = &out;
   t_us_ = t_us;
-  odometry_.push_back({t_us, odometry});
+  if (!odometry_.empty() && t_us < odometry_.back().t_us) return out;  // late: the series stays in order
+  odometry_.push_back({t_us, continuity_.Update(t_us, raw_odometry)});
   if (odometry_.front().t_us < t_us - 10'000'000) {  // trim to 5 s now and then, not every message
     odometry_.erase(odometry_.begin(), std::lower_bound(odometry_.begin(), odometry_.end(), t_us - 5'000'000,
                                                         [](const TimedPose& p, int64_t t) { return p.t_us < t; }));

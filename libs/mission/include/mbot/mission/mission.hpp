@@ -20,6 +20,7 @@
 #include "mbot/mapping/slam.hpp"
 #include "mbot/mission/mission_state.hpp"
 #include "mbot/motion/motion_controller.hpp"
+#include "mbot/motion/odometry_continuity.hpp"
 #include "mbot/motion/pose2d.hpp"
 #include "mbot/planning/exploration.hpp"
 
@@ -65,6 +66,7 @@ struct MissionReport {
   MissionStatus status;
   long long commands = 0, paths = 0, stale_pose_stops = 0;
   int corrections = 0, stall_recoveries = 0;
+  int odometry_restarts = 0;  // the robot's odometry started again from zero (a firmware restart)
   // warehouse: stops in all, and done by the mission's own estimate.
   int stops = 0, stops_done = 0;
 };
@@ -125,7 +127,8 @@ class Mission {
   motion::TimedPose slam_;
   bool has_slam_ = false;
   int64_t first_slam_us_ = -1, last_control_us_ = -1;
-  std::vector<motion::TimedPose> odometry_;  // the last ~5 s
+  std::vector<motion::TimedPose> odometry_;  // the last ~5 s, continuous across robot restarts
+  motion::OdometryContinuity continuity_;
   std::shared_ptr<const mapping::OccupancyGrid> map_;
   std::optional<mapping::SlamState> slam_state_;
   bool final_leg_ = false;  // the path ends at goal_, where the robot must stop within the tolerances

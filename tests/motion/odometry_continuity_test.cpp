@@ -1,0 +1,48 @@
+#include "mbot/motion/odometry_continuity.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace mbot::motion {
+namespace {
+
+// A robot driving a curve at 0.3 m/s, its odometry reported at 50 Hz; at 10 s its firmware restarts
+// and the odometry starts again from zero while the robot keeps driving.
+TEST(OdometryContinuity, ARestartIsReAnchoredAndNormalDrivingIsUntouched) {
+  OdometryContinuity c;
+  Pose2D truth, raw, restart_offset;
+  Pose2D last;
+  for (int k = 0; k <= 1000; ++k) {
+    const int64_t t_us = k * 20000;
+    if (k > 0) truth = truth.Compose(Pose2D{0.3 * 0.02, 0.0, 0.2 * 0.02});
+    if (k == 500) restart_offset = truth.Inverse();  // the firmware's new frame: here is zero
+    raw = restart_offset.Compose(truth);
+    last = c.Update(t_us, raw);
+    if (k < 500) {
+      EXPECT_NEAR(last.x, truth.x, 1e-9);
+      EXPECT_NEAR(last.y, truth.y, 1e-9);
+    }
+  }
+  EXPECT_EQ(c.restarts(), 1);
+  EXPECT_EQ(c.last_restart_us(), 500 * 20000);
+  // After the restart the continuous pose lags the truth by the one step the jump swallowed.
+  const Pose2D step{0.3 * 0.02, 0.0, 0.2 * 0.02};
+  const Pose2D expected = truth.Compose(step.Inverse());
+  EXPECT_NEAR(last.x, expected.x, 1e-6);
+  EXPECT_NEAR(last.y, expected.y, 1e-6);
+  EXPECT_NEAR(WrapAngle(last.theta - expected.theta), 0.0, 1e-6);
+}
+
+// A long gap in the messages (a silent link) is not a restart: the robot may have driven on.
+TEST(OdometryContinuity, AGapAllowsWhatTheRobotCouldDriveInIt) {
+  OdometryContinuity c;
+  c.Update(0, {0, 0, 0});
+  c.Update(3'000'000, {0.9, 0.0, 0.5});  // 3 s later, 0.9 m on: 0.3 m/s
+  EXPECT_EQ(c.restarts(), 0);
+  c.Update(3'020'000, {5.0, 0.0, 0.5});  // 4 m in 20 ms: no robot does that
+  EXPECT_EQ(c.restarts(), 1);
+}
+
+}  // namespace
+}  // namespace mbot::motion
