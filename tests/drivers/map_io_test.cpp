@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <iterator>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 
@@ -242,6 +243,24 @@ TEST(MapIoTest, SimplemapScansWithCorruptRangesCannotGrowTheGridWithoutBound) {
   const mapping::OccupancyGrid g = ReadMrptSimplemap(path);
   EXPECT_LE(static_cast<long long>(g.width()) * g.height(), kMaxMapCells);
   EXPECT_LT(g.width(), 1000);  // the sane scan's map, the far one left out
+}
+
+TEST(MapIoTest, SlamCheckpointRoundTrips) {
+  const auto ini = test::TempPath("ck/slam_checkpoint.ini");
+  std::filesystem::create_directories(std::filesystem::path(ini).parent_path());
+  SlamCheckpoint c;
+  c.pose = {1.25, -0.5, 0.75};
+  c.odometry = {1.5, -0.25, 0.5};
+  c.t_s = 30.25;
+  c.scans = 232;
+  WriteSlamCheckpoint(ini, Fixture(), c);
+  const SlamCheckpoint back = ReadSlamCheckpoint(ini);
+  EXPECT_EQ(back.map_path, (std::filesystem::path(ini).parent_path() / "slam_checkpoint.map").string());
+  EXPECT_NEAR(back.pose.x, 1.25, 1e-12);
+  EXPECT_NEAR(back.pose.theta, 0.75, 1e-12);
+  EXPECT_NEAR(back.odometry.y, -0.25, 1e-12);
+  EXPECT_EQ(back.scans, 232);
+  EXPECT_EQ(ReadBotlabMap(back.map_path).cells(), Fixture().cells());
 }
 
 TEST(MapIoTest, PngIsWritten) {

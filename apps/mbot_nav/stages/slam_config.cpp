@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "mbot/common/config.hpp"
+#include "mbot/drivers/map_io.hpp"
 #include "mbot/mapping/mapping_config.hpp"
 #include "mbot/motion/motion_config.hpp"
 
@@ -72,6 +73,31 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
   }
   o.initial_sigma_xy = s.GetDouble("initial_sigma_xy_m", 0.0, "spread of the first particles around the start", 0.0);
   o.initial_sigma_theta = s.GetDouble("initial_sigma_theta_rad", 0.0, "heading spread of the first particles", 0.0);
+
+  // Checkpoints: the map and pose written every so often, and a run resumed from them.
+  o.checkpoint_every_s = s.GetDouble("checkpoint_every_s", 0.0,
+                                     "write the map and pose to checkpoint_file this often, in the stream's time, so "
+                                     "a killed run can resume (0: never) [s]",
+                                     0.0, 1e6);
+  o.checkpoint_file = s.GetString("checkpoint_file", "slam_checkpoint.ini",
+                                  "the checkpoint's INI, in the output folder (its map beside it, as .map)");
+  o.resume_from = s.GetPath("resume_from", "",
+                            "a checkpoint INI to start from: its map becomes map_file and its pose the initial_pose "
+                            "(for full SLAM the map keeps growing)");
+  if (!o.resume_from.empty() && !s.describing()) {
+    if (m.mode == mapping::SlamMode::kMappingOnly || m.mode == mapping::SlamMode::kActionOnly) {
+      s.Fail("resume_from", "needs mode = full_slam or localization (a map to localize in)");
+    }
+    try {
+      const drivers::SlamCheckpoint c = drivers::ReadSlamCheckpoint(o.resume_from);
+      o.map_file = c.map_path;
+      o.initial = "pose";
+      o.initial_pose = c.pose;
+      o.resume_odometry = c.odometry;
+    } catch (const std::exception& e) {
+      s.Fail("resume_from", e.what());
+    }
+  }
 
   // Perturbations.
   auto& pert = o.perturbation;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "mbot/mapping/slam.hpp"
@@ -36,6 +37,10 @@ struct SlamStageOptions {
   std::string initial = "origin";  // origin | odometry | ground_truth | reference | global | pose
   motion::Pose2D initial_pose;
   double initial_sigma_xy = 0.0, initial_sigma_theta = 0.0;
+  double checkpoint_every_s = 0.0;  // 0: no checkpoints
+  std::string checkpoint_file = "slam_checkpoint.ini";
+  std::string resume_from;                        // a checkpoint INI (sets map_file and initial_pose)
+  std::optional<motion::Pose2D> resume_odometry;  // the odometry the checkpoint was written at
   // Perturbations for robustness tests.
   motion::OdometryPerturbationOptions perturbation;
   // Outputs.

@@ -5,6 +5,7 @@
 // SLAM's status, the particles and the map to the later stages; at the end slam_outputs.cpp writes
 // the map, the trajectories and metrics.json.
 #include <chrono>
+#include <filesystem>
 #include <cmath>
 #include <optional>
 
@@ -43,6 +44,13 @@ class SlamStage : public Stage {
     }
     consistency_model_ = mapping::SensorModel(options_.slam.sensor);
     wall_start_ = std::chrono::steady_clock::now();
+    if (!options_.resume_from.empty()) {
+      mbot::log::Info("slam: resuming from checkpoint " + options_.resume_from + " at (" +
+                      std::to_string(options_.initial_pose.x) + ", " + std::to_string(options_.initial_pose.y) + ")");
+    }
+    if (options_.checkpoint_every_s > 0) {
+      checkpoint_path_ = (std::filesystem::path(ctx.output_dir) / options_.checkpoint_file).string();
+    }
   }
 
   void OnEvent(const drivers::Event& in) override {
@@ -118,6 +126,21 @@ class SlamStage : public Stage {
       for (const mapping::Particle& q : slam_.filter().particles()) particle_snapshots_.push_back(q.pose);
     }
     TrackEvents(r);
+    MaybeCheckpoint(r);
+  }
+
+  // The map and pose, every checkpoint_every_s of the stream's time, for a run that has to resume.
+  void MaybeCheckpoint(const ScanRecord& r) {
+    if (checkpoint_path_.empty()) return;
+    if (last_checkpoint_us_ >= 0 && r.t_us - last_checkpoint_us_ < options_.checkpoint_every_s * 1e6) return;
+    last_checkpoint_us_ = r.t_us;
+    try {
+      drivers::WriteSlamCheckpoint(
+          checkpoint_path_, slam_.map(),
+          {"", r.slam, r.odometry, (r.t_us - inputs_->first_t_us()) * 1e-6, static_cast<long long>(records_.size())});
+    } catch (const std::exception& e) {
+      mbot::log::WarnOnce("slam:checkpoint", std::string("slam: cannot write the checkpoint: ") + e.what());
+    }
   }
 
   // The estimate goes to the later stages (planner, explorer, controller) and the sink: the pose at
@@ -165,6 +188,11 @@ class SlamStage : public Stage {
       }
     } else if (options_.initial == "odometry") {
       start = odometry;
+    } else if (options_.resume_odometry) {
+      // Resuming: the robot may have moved since the checkpoint; its odometry says how far, unless
+      // it restarted too (then its odometry is in a new frame and the checkpoint's pose is the guess).
+      const Pose2D moved = options_.resume_odometry->Inverse().Compose(odometry);
+      if (std::hypot(moved.x, moved.y) < 2.0) start = start.Compose(moved);
     }
     slam_.Initialize(start, odometry, options_.initial_sigma_xy, options_.initial_sigma_theta);
     return true;
@@ -180,6 +208,8 @@ class SlamStage : public Stage {
   SlamStageOptions options_;
   mapping::Slam slam_;
   mapping::SlamEventTracker events_;
+  std::string checkpoint_path_;  // empty: no checkpoints
+  int64_t last_checkpoint_us_ = -1;
   std::optional<SlamInputs> inputs_;
   Bus* bus_ = nullptr;
   std::optional<mapping::SlamState> published_state_;

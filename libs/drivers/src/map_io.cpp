@@ -19,6 +19,7 @@
 #include <stdexcept>
 
 #include "mbot/common/atomic_file.hpp"
+#include "mbot/common/config.hpp"
 #include "mbot/common/files.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/common/strings.hpp"
@@ -458,6 +459,41 @@ mapping::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format) 
     return ReadBotlabMap(path);
   }
   Fail(path, "not a known map format (.map, .yaml, .gridmap, .gridmap.gz, .simplemap, .simplemap.gz)");
+}
+
+void WriteSlamCheckpoint(const std::string& ini_path, const mapping::OccupancyGrid& map, const SlamCheckpoint& c) {
+  const fs::path ini(ini_path);
+  const fs::path map_path = fs::path(ini).replace_extension(".map");
+  WriteBotlabMap(map, map_path.string());
+  WriteFileAtomically(ini_path, [&](std::ostream& out) {
+    out << "# mbot_nav SLAM checkpoint: resume with --set slam.resume_from=" << ini_path << "\n"
+        << "[checkpoint]\n"
+        << "map = " << map_path.filename().string() << "\n"
+        << "pose = " << ShortestDouble(c.pose.x) << ", " << ShortestDouble(c.pose.y) << ", "
+        << ShortestDouble(c.pose.theta * 180.0 / M_PI) << "\n"
+        << "odometry = " << ShortestDouble(c.odometry.x) << ", " << ShortestDouble(c.odometry.y) << ", "
+        << ShortestDouble(c.odometry.theta * 180.0 / M_PI) << "\n"
+        << "t_s = " << ShortestDouble(c.t_s) << "\n"
+        << "scans = " << c.scans << "\n";
+  });
+}
+
+SlamCheckpoint ReadSlamCheckpoint(const std::string& ini_path) {
+  RequireReadableFile(ini_path);
+  const config::Config cfg = config::Config::Load(ini_path);
+  config::Section s = cfg.GetSection("checkpoint");
+  if (!cfg.HasSection("checkpoint")) Fail(ini_path, "no [checkpoint] section (not a SLAM checkpoint)");
+  SlamCheckpoint c;
+  const std::string map = s.GetString("map", "", "the checkpoint's map, beside it");
+  if (map.empty()) s.Fail("map", "required");
+  c.map_path = (fs::path(ini_path).parent_path() / map).string();
+  const config::PoseValue p = s.GetPose("pose", {}, "the estimate at the last scan");
+  c.pose = {p.x_m, p.y_m, p.theta_rad};
+  const config::PoseValue o = s.GetPose("odometry", {}, "the robot's odometry at the last scan");
+  c.odometry = {o.x_m, o.y_m, o.theta_rad};
+  c.t_s = s.GetDouble("t_s", 0.0, "the last scan's time [s]", -1e12, 1e12);
+  c.scans = s.GetInt("scans", 0, "scans processed", 0, 1LL << 50);
+  return c;
 }
 
 }  // namespace mbot::drivers

@@ -118,9 +118,9 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
     return u;
   }
   if (state_ == ExplorationState::kInitializing) {
-    home_ = pose;
+    home_ = options_.home.value_or(pose);
     state_ = ExplorationState::kExploring;
-    u.reason = Format("home fixed at (%.2f, %.2f)", pose.x, pose.y);
+    u.reason = Format("home fixed at (%.2f, %.2f)", home_.x, home_.y);
   }
   const double radius = options_.astar.robot_radius_m;
   auto plan_home = [&](const std::string& why) {

@@ -58,6 +58,12 @@ ExplorationOptions ParseExplorationOptions(config::Section& s, const Exploration
   o.frontier = ParseFrontierOptions(s, d.frontier);
   o.home_tolerance_m = s.GetDouble("home_tolerance_m", d.home_tolerance_m,
                                    "exploration is completed when the robot is this close to home [m]", 0.0, 10.0);
+  const std::vector<config::PoseValue> home =
+      s.GetPoses("home", {},
+                 "exploration's home, x, y, theta_deg in the map frame (default: where the robot is when exploration "
+                 "starts; set it when resuming a run from a SLAM checkpoint)");
+  if (home.size() > 1) s.Fail("home", "one pose, x, y, theta_deg");
+  if (!home.empty()) o.home = motion::Pose2D{home[0].x_m, home[0].y_m, home[0].theta_rad};
   o.target_reached_m = s.GetDouble("target_reached_m", d.target_reached_m,
                                    "a frontier target counts as reached this close [m]", 0.0, 10.0);
   o.resolve_wait_s =

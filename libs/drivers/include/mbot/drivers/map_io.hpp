@@ -70,4 +70,20 @@ bool IsMapFile(const std::string& path);
 // Reads any of the formats above, chosen by extension and content (simplemaps at 0.05 m).
 mapping::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format = nullptr);
 
+// A SLAM checkpoint, so an autonomy killed mid-run starts again from what it had mapped: the map as a
+// botlab .map beside an INI file ([checkpoint] map, pose and odometry = x, y, theta_deg, t_s, scans). The map is
+// written (atomically) before the INI, so an INI always names a whole map.
+struct SlamCheckpoint {
+  std::string map_path;     // absolute, as read back
+  motion::Pose2D pose;      // the estimate at the last scan
+  motion::Pose2D odometry;  // the robot's odometry then (a resumed run adds what it moved since)
+  double t_s = 0.0;         // that scan's time
+  long long scans = 0;      // scans processed when it was written
+};
+// Writes `<ini_path minus .ini>.map` and then `ini_path`.
+void WriteSlamCheckpoint(const std::string& ini_path, const mapping::OccupancyGrid& map, const SlamCheckpoint& c);
+// Reads a checkpoint INI (its map path is resolved against the INI's folder); throws
+// std::runtime_error / config::ConfigError naming the file and key.
+SlamCheckpoint ReadSlamCheckpoint(const std::string& ini_path);
+
 }  // namespace mbot::drivers

@@ -20,8 +20,9 @@ struct ExplorationOptions {
   // Exploration keeps to mapped space: unknown cells count as obstacles for distances and paths.
   ObstacleDistanceOptions distance{/*unknown_is_obstacle=*/true};
   FrontierOptions frontier;
-  double home_tolerance_m = 0.03;  // completed when the robot is this close to home
-  double target_reached_m = 0.10;  // a frontier target counts as reached this close
+  double home_tolerance_m = 0.03;      // completed when the robot is this close to home
+  std::optional<motion::Pose2D> home;  // where to return; default: the pose exploration starts at
+  double target_reached_m = 0.10;      // a frontier target counts as reached this close
   // The map reaches the explorer some scans after the robot: a frontier counts as unresolved only
   // when it is still there this long after its target was reached.
   double resolve_wait_s = 1.0;
