@@ -33,10 +33,11 @@ build=${MBOT_FUZZ_BUILD_DIR:-$root/build-fuzz}
 datasets=${MBOT_DATASETS_DIR:-$root/../shared/datasets}
 if [ "${MBOT_FUZZ_NO_BUILD:-0}" != 1 ]; then
   ./scripts/install_deps.sh --fuzz
+  mkdir -p "$build"
   CC=clang CXX=clang++ cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g" -DMBOT_FUZZ=ON -DMBOT_BUILD_TESTS=OFF \
-    "-DMBOT_DATASETS_DIR=$datasets" > "$build.configure.log" 2>&1 ||
-    { cat "$build.configure.log"; exit 1; }
+    "-DMBOT_DATASETS_DIR=$datasets" > "$build/configure.log" 2>&1 ||
+    { cat "$build/configure.log"; exit 1; }
   if [ "$target" = all ]; then cmake --build "$build" --target fuzz_targets; else cmake --build "$build" --target "fuzz_$target"; fi
 fi
 

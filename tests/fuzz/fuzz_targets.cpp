@@ -55,9 +55,9 @@ void Drain(const std::string& path, const std::string& type) {
 }
 
 // The channels lcm_messages decodes on: the roles the decoder gives them differ.
-const char* const kChannels[] = {"LIDAR",         "ODOMETRY",      "MBOT_ODOMETRY", "TRUE_POSE",
-                                 "GROUND_TRUTH_POSE", "SLAM_POSE", "MBOT_ENCODERS", "MBOT_IMU",
-                                 "MBOT_VEL_CMD",  "MBOT_MOTOR_PWM", "SLAM_MAP",     "OTHER"};
+const char* const kChannels[] = {"LIDAR",     "ODOMETRY",      "MBOT_ODOMETRY", "TRUE_POSE",    "GROUND_TRUTH_POSE",
+                                 "SLAM_POSE", "MBOT_ENCODERS", "MBOT_IMU",      "MBOT_VEL_CMD", "MBOT_MOTOR_PWM",
+                                 "SLAM_MAP",  "OTHER"};
 constexpr size_t kChannelCount = sizeof kChannels / sizeof *kChannels;
 
 [[maybe_unused]] void LcmLog(const uint8_t* d, size_t n) { Drain(Write("in.log", d, n), "lcm_log"); }
@@ -76,7 +76,9 @@ constexpr size_t kChannelCount = sizeof kChannels / sizeof *kChannels;
 [[maybe_unused]] void Carmen(const uint8_t* d, size_t n) { Drain(Write("in.clf", d, n), "carmen"); }
 [[maybe_unused]] void BotlabMap(const uint8_t* d, size_t n) { mbot::drivers::ReadBotlabMap(Write("in.map", d, n)); }
 [[maybe_unused]] void Gridmap(const uint8_t* d, size_t n) { mbot::drivers::ReadMrptGridmap(Write("in.gridmap", d, n)); }
-[[maybe_unused]] void Simplemap(const uint8_t* d, size_t n) { mbot::drivers::ReadMrptSimplemap(Write("in.simplemap", d, n)); }
+[[maybe_unused]] void Simplemap(const uint8_t* d, size_t n) {
+  mbot::drivers::ReadMrptSimplemap(Write("in.simplemap", d, n));
+}
 [[maybe_unused]] void MovingAiMap(const uint8_t* d, size_t n) { mbot::drivers::ReadMovingAiMap(Write("in.map", d, n)); }
 
 // The YAML up to the first NUL byte, the image after it (saved as the map.pgm the seeds name).
@@ -92,9 +94,9 @@ constexpr size_t kChannelCount = sizeof kChannels / sizeof *kChannels;
 [[maybe_unused]] void MovingAiScenarios(const uint8_t* d, size_t n) {
   static const bool map_written = [] {
     std::ofstream((Scratch() / "tiny.map").string()) << "type octile\nheight 8\nwidth 8\nmap\n"
-                                                      << std::string(8, '.') + "\n" + std::string(8, '.') + "\n"
-                                                      << "...@@...\n...@@...\n........\n........\n........\n"
-                                                      << "........\n";
+                                                     << std::string(8, '.') + "\n" + std::string(8, '.') + "\n"
+                                                     << "...@@...\n...@@...\n........\n........\n........\n"
+                                                     << "........\n";
     return true;
   }();
   (void)map_written;

@@ -67,6 +67,10 @@ LiveSourceOptions ParseLiveSourceOptions(config::Section& s) {
   return o;
 }
 
+// lcm_relay.cpp
+void ParseRelayOptions(config::Section& s, SourceOptions* o);
+std::unique_ptr<Source> OpenLcmRelay(const SourceOptions& options);
+
 namespace {
 
 bool IsCarmenText(const std::string& path) {
@@ -123,6 +127,10 @@ std::deque<SourceType> BuiltInTypes() {
   t.push_back({"lcm_live", "a robot (or the simulated one) on the LCM bus, in wall-clock time; path is the LCM url",
                nullptr, 0, [](config::Section& s, SourceOptions* o) { o->live = ParseLiveSourceOptions(s); },
                [](const SourceOptions& o) { return std::make_unique<LcmLiveSource>(o); }});
+  t.push_back({"lcm_relay",
+               "a fault-injecting relay between the robot's LCM group (url) and the autonomy's (relay_url): drops, "
+               "delay, jitter, duplicates, reordering, corruption, silences",
+               nullptr, 0, ParseRelayOptions, OpenLcmRelay});
   return t;
 }
 
@@ -155,9 +163,10 @@ SourceOptions ParseSourceOptions(config::Section& s) {
   o.type = s.GetChoice("type", o.type, names,
                        "input format; auto detects it from the path and the file's content (an .arena file is the "
                        "simulator's world); lcm_live: a robot on the LCM bus (mbot_nav --list-sources)");
-  const bool live = o.type == "lcm_live";
+  const bool live = o.type == "lcm_live" || o.type == "lcm_relay";
   if (live || s.describing()) {
-    o.path = s.GetString("url", kDefaultLcmUrl, "lcm_live: the LCM URL (ttl=0 keeps the traffic on this machine)");
+    o.path = s.GetString("url", kDefaultLcmUrl,
+                         "lcm_live: the LCM URL (ttl=0 keeps the traffic on this machine); lcm_relay: the robot's");
   }
   if (!live) {
     o.path = s.RequirePath("path",
@@ -229,10 +238,11 @@ std::unique_ptr<Source> OpenSource(const SourceOptions& options) {
   const SourceType* t = FindSourceType(type);
   if (!t) throw std::runtime_error("source type '" + type + "' is not known");
   // Only the A* cases come as a folder; a folder anywhere else would read as an empty file.
-  if (type != "astar_cases" && type != "lcm_live" && std::filesystem::is_directory(options.path)) {
+  const bool bus = type == "lcm_live" || type == "lcm_relay";
+  if (type != "astar_cases" && !bus && std::filesystem::is_directory(options.path)) {
     throw std::runtime_error(options.path + ": is a directory, not a " + type + " file");
   }
-  if (type != "astar_cases" && type != "lcm_live" && !options.path.empty()) RequireReadableFile(options.path);
+  if (type != "astar_cases" && !bus && !options.path.empty()) RequireReadableFile(options.path);
   return t->open(options);
 }
 

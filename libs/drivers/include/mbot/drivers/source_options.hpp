@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "mbot/drivers/lcm_relay.hpp"
 #include "mbot/drivers/source.hpp"
 
 namespace mbot::config {
@@ -55,6 +56,8 @@ struct SourceOptions {
   // the pipeline; not a [source] key).
   uint64_t seed = 1;
   LiveSourceOptions live;  // read only when type = lcm_live
+  RelayOptions relay;      // read only when type = lcm_relay (path is then its robot_url)
+  double relay_duration_s = 0.0;
   // The options of a source type registered by another library (the simulator's SimSourceOptions),
   // filled by that type's `parse`.
   std::any extra;
