@@ -1,5 +1,7 @@
 #include "slam_inputs.hpp"
 
+#include <algorithm>
+
 #include <cstdlib>
 
 #include "mbot/common/log.hpp"
@@ -115,6 +117,16 @@ void SlamInputs::AddOdometry(int64_t t_us, const Pose2D& raw) {
   }
   const Pose2D out = perturbation_.Apply(t_us, first_t_us_, continuous);
   odometry_.push_back({t_us, out});
+}
+
+void SlamInputs::TrimBefore(int64_t t_us) {
+  constexpr size_t kBatch = 4096;  // erase in batches: the vectors are scanned, not shifted, per call
+  for (std::vector<TimedPose>* series : {&odometry_, &ground_truth_, &reference_}) {
+    const auto first_kept = std::lower_bound(series->begin(), series->end(), t_us,
+                                             [](const TimedPose& p, int64_t t) { return p.t_us < t; });
+    const size_t drop = first_kept == series->begin() ? 0 : static_cast<size_t>(first_kept - series->begin()) - 1;
+    if (drop >= kBatch) series->erase(series->begin(), series->begin() + static_cast<std::ptrdiff_t>(drop));
+  }
 }
 
 }  // namespace mbot::app

@@ -51,6 +51,11 @@ class SlamInputs {
   int64_t kidnapped_at_us() const { return perturbation_.kidnapped_at_us(); }
   int odometry_restarts() const { return continuity_.restarts(); }
 
+  // Drops the pose series' entries before t_us, keeping the last one before it (an interpolation
+  // at t_us still has both neighbours), so a run of any length keeps bounded memory. Cheap to call
+  // often: it trims only once a few thousand entries are due.
+  void TrimBefore(int64_t t_us);
+
  private:
   const drivers::Event& Retime(const drivers::Event& ev, drivers::Event* copy);
   bool Accept(std::string* chosen, const std::string& wanted, const drivers::Event& ev);

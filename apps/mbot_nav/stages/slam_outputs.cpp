@@ -25,13 +25,13 @@ std::vector<Pose2D> PosesOf(const std::vector<TimedPose>& s) {
 void WriteScansCsv(const std::string& path, const std::vector<ScanRecord>& records) {
   WriteFileAtomically(path, [&](std::ostream& o) {
     o << "t_s,x,y,theta,filter_updated,particles,ess,spread_m,inlier_fraction,fit_ratio,injected,lost,converged,update_"
-         "ms\n";
+         "ms,rss_mb\n";
     char line[256];
     for (const ScanRecord& r : records) {
-      std::snprintf(line, sizeof line, "%.6f,%.4f,%.4f,%.5f,%d,%d,%.1f,%.4f,%.3f,%.3f,%d,%d,%d,%.3f\n", r.t_us * 1e-6,
-                    r.slam.x, r.slam.y, r.slam.theta, r.updated, r.status.particles, r.status.ess, r.status.spread_m,
-                    r.status.inlier_fraction, r.status.fit_ratio, r.status.injected, r.status.lost, r.status.converged,
-                    r.update_ms);
+      std::snprintf(line, sizeof line, "%.6f,%.4f,%.4f,%.5f,%d,%d,%.1f,%.4f,%.3f,%.3f,%d,%d,%d,%.3f,%.1f\n",
+                    r.t_us * 1e-6, r.slam.x, r.slam.y, r.slam.theta, r.updated, r.status.particles, r.status.ess,
+                    r.status.spread_m, r.status.inlier_fraction, r.status.fit_ratio, r.status.injected, r.status.lost,
+                    r.status.converged, r.update_ms, r.rss_mb);
       o << line;
     }
   });
@@ -55,7 +55,12 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& ru
     slam_path.push_back({r.t_us, r.slam});
     odometry_path.push_back({r.t_us, r.odometry});
     Pose2D t;
-    if (!motion::InterpolateAt(truth_series, r.t_us, max_gap, &t)) continue;
+    const std::optional<Pose2D>& kept = options.truth_is_reference ? r.reference : r.truth;
+    if (kept) {
+      t = *kept;
+    } else if (!motion::InterpolateAt(truth_series, r.t_us, max_gap, &t)) {
+      continue;
+    }
     truth_path.push_back({r.t_us, t});
     const bool late = options.score_max_latency_us > 0 && r.latency_us > options.score_max_latency_us;
     unscored_late += late;
@@ -64,7 +69,8 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& ru
     odo_paired.push_back(r.odometry);
     truth_paired.push_back(t);
     Pose2D ref;
-    if (!options.truth_is_reference && motion::InterpolateAt(*run.reference, r.t_us, max_gap, &ref)) {
+    if (!options.truth_is_reference &&
+        (r.reference ? (ref = *r.reference, true) : motion::InterpolateAt(*run.reference, r.t_us, max_gap, &ref))) {
       ref_paired.push_back(ref);
       ref_truth_paired.push_back(t);
     }
@@ -96,7 +102,7 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& ru
     model.SetMap(map);
     double sum = 0;
     for (size_t i = 0; i < run.scan_points->size(); ++i)
-      sum += model.InlierFraction(records[i].slam, (*run.scan_points)[i]);
+      sum += model.InlierFraction(records[(*run.scan_points)[i].record].slam, (*run.scan_points)[i].points);
     consistency = sum / run.scan_points->size();
   }
   std::vector<double> update_ms, filter_ms, ess;

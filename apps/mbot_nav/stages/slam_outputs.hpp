@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,16 +24,26 @@ struct ScanRecord {
   mapping::FilterStatus status;
   double update_ms = 0;
   int64_t latency_us = 0;
+  double rss_mb = 0;  // the process's resident memory, sampled every 64 scans (soak runs watch it)
+  // The truth and the reference at the scan's time, once their series have passed it (the series
+  // are trimmed behind the scans, so these are kept here).
+  std::optional<motion::Pose2D> truth, reference;
+};
+
+// A scan kept for the map-consistency metric: its record's index and its points.
+struct KeptScan {
+  size_t record = 0;
+  mapping::ScanPoints points;
 };
 
 struct SlamRun {
   const SlamStageOptions* options = nullptr;
   const mapping::Slam* slam = nullptr;
   const std::vector<ScanRecord>* records = nullptr;
-  const std::vector<motion::TimedPose>* ground_truth = nullptr;
+  const std::vector<motion::TimedPose>* ground_truth = nullptr;  // the recent part, for records not yet paired
   const std::vector<motion::TimedPose>* reference = nullptr;
   const mapping::SlamEventTracker* events = nullptr;
-  const std::vector<mapping::ScanPoints>* scan_points = nullptr;  // per record (the first ones), for consistency
+  const std::vector<KeptScan>* scan_points = nullptr;  // a uniform sample of the records, for consistency
   const std::vector<motion::Pose2D>* particle_snapshots = nullptr;
   int64_t first_t_us = -1, last_t_us = -1, kidnapped_at_us = -1;
   int skipped_scans = 0;
