@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -30,10 +32,15 @@ World Box(double half) {
   return World::ParseArena(a.str(), "box.arena");
 }
 
+// Commands (v, w) every 0.1 s until `until_s`, as a controller does (the firmware stops the motors
+// after 1 s without a command).
 std::vector<Event> Drive(SimRobot& robot, double v, double w, double until_s) {
   std::vector<Event> out;
-  robot.Command(v, w);
-  robot.AdvanceTo(static_cast<int64_t>(until_s * kSecond), &out);
+  const int64_t until = static_cast<int64_t>(until_s * kSecond);
+  while (robot.now_us() < until) {
+    robot.Command(v, w);
+    robot.AdvanceTo(std::min(until, robot.now_us() + kSecond / 10), &out);
+  }
   return out;
 }
 

@@ -58,7 +58,7 @@ class MissionStage : public Stage {
       << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"commands\": " << r.commands
       << ",\n  \"paths\": " << r.paths << ",\n  \"stale_pose_stops\": " << r.stale_pose_stops
       << ",\n  \"corrections\": " << r.corrections << ",\n  \"stall_recoveries\": " << r.stall_recoveries
-      << ",\n  \"odometry_restarts\": " << r.odometry_restarts;
+      << ",\n  \"odometry_restarts\": " << r.odometry_restarts << ",\n  \"rounds\": " << r.rounds;
     if (r.task == mission::TaskKind::kWarehouse)
       j << ",\n  \"stops\": " << r.stops << ",\n  \"stops_done\": " << r.stops_done;
     j << "\n}\n";

@@ -33,7 +33,7 @@ const char* ToString(TaskKind kind) {
 }
 
 Mission::Mission(const MissionOptions& options, uint64_t seed)
-    : o_(options), task_(MakeTask(o_, seed)), controller_(o_.controller) {}
+    : o_(options), task_(MakeTask(o_, seed)), controller_(o_.controller), seed_(seed) {}
 
 Mission::~Mission() = default;
 
@@ -56,6 +56,7 @@ MissionReport Mission::Report() const {
   r.commands = commands_, r.paths = paths_, r.stale_pose_stops = stale_stops_;
   r.corrections = total_corrections_, r.stall_recoveries = recoveries_;
   r.odometry_restarts = continuity_.restarts();
+  r.rounds = rounds_ + 1;
   task_->AddToReport(&r);
   return r;
 }
@@ -79,6 +80,13 @@ std::vector<MissionOutput> Mission::OnOdometry(int64_t t_us, const Pose2D& raw_o
   } else if ((t_us - slam_.t_us) * 1e-6 > o_.max_pose_age_s) {
     ++stale_stops_;
     SetState(status_.state, "SLAM pose stale: stopped");
+    Hold();
+  } else if (status_.state == MissionState::kCompleted && rounds_ < o_.repeat) {
+    ++rounds_;  // a soak: the task again, with the next seed (a warehouse's next order)
+    task_ = MakeTask(o_, seed_ + static_cast<uint64_t>(rounds_));
+    final_leg_ = false;
+    SetState(MissionState::kInitializing,
+             "round " + std::to_string(rounds_ + 1) + " of " + std::to_string(o_.repeat + 1));
     Hold();
   } else if (IsFinal(status_.state) && !task_->Resumes()) {
     Hold();  // done (follow: until the next path, which a failure does not end)

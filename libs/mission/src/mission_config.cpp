@@ -50,6 +50,10 @@ MissionOptions ParseMissionOptions(config::Section& s) {
                                   "short run (0: all the rules ask)",
                                   0, warehouse::TotalDeliveries()));
   }
+  o.repeat = static_cast<int>(s.GetInt("repeat", o.repeat,
+                                       "start the task again this many times once it completes (a soak run; the "
+                                       "warehouse takes the next seed's order each round)",
+                                       0, 1000000));
   o.controller = motion::ParseMotionControllerOptions(s);
   o.exploration = planning::ParseExplorationOptions(s);
   o.explore_period_s =

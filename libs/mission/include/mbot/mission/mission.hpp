@@ -38,6 +38,7 @@ struct MissionOptions {
   std::vector<motion::Pose2D> targets;
   std::vector<motion::Pose2D> dropoffs;
   int deliveries = 0;  // warehouse: make only the first this many of the seed's order (0: all the rules ask)
+  int repeat = 0;      // start the task again this many times once it completes (soak runs)
   motion::MotionControllerOptions controller;
   planning::ExplorationOptions exploration;
   double explore_period_s = 0.25;  // explorer updates at most this often [s]
@@ -66,7 +67,9 @@ struct MissionReport {
   MissionStatus status;
   long long commands = 0, paths = 0, stale_pose_stops = 0;
   int corrections = 0, stall_recoveries = 0;
-  int odometry_restarts = 0;  // the robot's odometry started again from zero (a firmware restart)
+  int odometry_restarts = 0;
+  int rounds = 1;  // rounds of the task run (repeat + 1 when all completed)  // the robot's odometry started again from
+                   // zero (a firmware restart)
   // warehouse: stops in all, and done by the mission's own estimate.
   int stops = 0, stops_done = 0;
 };
@@ -132,6 +135,8 @@ class Mission {
   std::shared_ptr<const mapping::OccupancyGrid> map_;
   std::optional<mapping::SlamState> slam_state_;
   bool final_leg_ = false;  // the path ends at goal_, where the robot must stop within the tolerances
+  uint64_t seed_ = 0;
+  int rounds_ = 0;  // completed rounds started again (repeat)
   motion::Pose2D goal_;
   motion::Pose2D stall_goal_{1e9, 1e9, 0};  // the goal the stall budget is for
   MissionStatus status_;
