@@ -40,8 +40,23 @@ TEST(OdometryContinuity, AGapAllowsWhatTheRobotCouldDriveInIt) {
   c.Update(0, {0, 0, 0});
   c.Update(3'000'000, {0.9, 0.0, 0.5});  // 3 s later, 0.9 m on: 0.3 m/s
   EXPECT_EQ(c.restarts(), 0);
-  c.Update(3'020'000, {5.0, 0.0, 0.5});  // 4 m in 20 ms: no robot does that
+  c.Update(3'020'000, {5.0, 0.0, 0.5});  // 4 m in 20 ms: no robot does that…
+  c.Update(3'040'000, {5.0, 0.0, 0.5});  // …and it stays there: a restart
   EXPECT_EQ(c.restarts(), 1);
+}
+
+// One corrupt message (a float's bytes changed on the link) is dropped, not taken for a restart.
+TEST(OdometryContinuity, OneCorruptMessageIsDropped) {
+  OdometryContinuity c;
+  EXPECT_NEAR(c.Update(0, {1.0, 2.0, 0.1}).x, 1.0, 1e-12);
+  EXPECT_NEAR(c.Update(20'000, {1.0, 2.0, 0.1}).x, 1.0, 1e-12);
+  EXPECT_NEAR(c.Update(40'000, {7e13, 2.0, 0.1}).x, 1.0, 1e-12);  // beyond ±1e5 m: never a pose
+  EXPECT_NEAR(c.Update(60'000, {1.5, 2.0, 0.1}).x, 1.0, 1e-12);   // a jump: held until the next one
+  const Pose2D p = c.Update(80'000, {1.006, 2.0, 0.1});           // back where it was: that was corrupt
+  EXPECT_NEAR(p.x, 1.006, 1e-12);
+  EXPECT_NEAR(p.y, 2.0, 1e-12);
+  EXPECT_EQ(c.restarts(), 0);
+  EXPECT_EQ(c.outliers(), 2);
 }
 
 }  // namespace

@@ -85,6 +85,15 @@ const drivers::Event& SlamInputs::Retime(const drivers::Event& ev, drivers::Even
     if (!same_clock) mbot::log::Info("slam: " + ev.channel + " stamps use another clock; using arrival times");
   }
   if (!it->second) return ev;
+  // On a channel whose stamps share the log's clock, a stamp seconds away from the arrival is corrupt:
+  // placed there it would hold the pose series back (later messages look older) or jump it ahead.
+  if (o_.time_base != "stamp" && std::llabs(ev.stamp_us - ev.t_us) > 2'000'000) {
+    ++stamp_outliers_;
+    mbot::log::WarnOnce("slam:stamp:" + ev.channel,
+                        "slam: " + ev.channel + ": a stamp " + std::to_string((ev.stamp_us - ev.t_us) * 1e-6) +
+                            " s from its arrival: placed at its arrival (further ones are counted)");
+    return ev;
+  }
   if (ev.kind != EventKind::kLidar && ev.kind != EventKind::kOdometry && ev.kind != EventKind::kEncoders &&
       ev.kind != EventKind::kGroundTruth && ev.kind != EventKind::kReferencePose) {
     return ev;
@@ -108,8 +117,13 @@ bool SlamInputs::Accept(std::string* chosen, const std::string& wanted, const dr
 // perturbations (noise, a kidnapping jump).
 void SlamInputs::AddOdometry(int64_t t_us, const Pose2D& raw) {
   if (!odometry_.empty() && t_us < odometry_.back().t_us) return;
-  const int restarts = continuity_.restarts();
+  const int restarts = continuity_.restarts(), outliers = continuity_.outliers();
   const Pose2D continuous = continuity_.Update(t_us, raw);
+  if (continuity_.outliers() > outliers) {
+    mbot::log::WarnOnce("slam:odometry_outlier",
+                        "slam: an odometry message that jumps away and back (corrupt) is "
+                        "dropped; further ones are counted");
+  }
   if (continuity_.restarts() > restarts) {
     mbot::log::Warn("slam: odometry jumped by more than a robot can move at " +
                     std::to_string((t_us - first_t_us_) * 1e-6) +

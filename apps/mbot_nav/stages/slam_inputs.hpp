@@ -70,6 +70,7 @@ class SlamInputs {
   std::deque<Scan> pending_;
   std::map<std::string, bool> stamp_channels_;  // channel → its stamps share the log's clock
   int64_t previous_scan_us_ = -1;
+  long long stamp_outliers_ = 0;  // stamps far from their arrival, placed at the arrival instead
   int64_t first_t_us_ = -1, last_t_us_ = -1;
 };
 

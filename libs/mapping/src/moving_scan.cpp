@@ -59,8 +59,15 @@ BeamTimes TimeBeams(BeamTiming timing, const std::vector<float>& angles, const s
                     int64_t period) {
   BeamTimes out;
   const size_t n = angles.size();
-  const bool beams_usable =
-      beam_times.size() == n && n > 1 && period > 0 && beam_times.back() - beam_times.front() > period / 2;
+  // Beam times are usable when they span between half and twice the scan period and run forward
+  // (a corrupt time, or one on another clock, would place beams far from the scan). In doubles: a
+  // corrupt int64 must not overflow the subtraction.
+  bool beams_usable = beam_times.size() == n && n > 1 && period > 0;
+  if (beams_usable) {
+    const double span = double(beam_times.back()) - double(beam_times.front());
+    beams_usable = span > period / 2.0 && span <= 2.0 * period;
+    for (size_t i = 1; beams_usable && i < n; ++i) beams_usable = beam_times[i] >= beam_times[i - 1];
+  }
   if (timing == BeamTiming::kBeams || (timing == BeamTiming::kAuto && beams_usable)) {
     if (!beams_usable) {
       out.beam_times_unusable = true;
