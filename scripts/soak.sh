@@ -18,7 +18,8 @@ grep -E "^done:|slam: [0-9]+ scans" "$out.log"
 rounds=$(sed -n 's/.*"rounds": \([0-9]*\).*/\1/p' "$out/mission.json")
 echo "warehouse rounds: $rounds"
 awk -F, 'NR > 1 {
-    bin = int($1 / 300); n[bin]++; v[bin, n[bin]] = $14; if ($15 > 0) rss[bin] = $15; if (bin > last) last = bin
+    bin = int($1 / 300); if (bin > 0 && $1 == bin * 300) bin--  # 3600.0 s is the last of the hour
+    n[bin]++; v[bin, n[bin]] = $14; if ($15 > 0) rss[bin] = $15; if (bin > last) last = bin
   }
   END {
     print "sim_min  scans  median_ms  p95_ms  rss_mb"

@@ -4,6 +4,8 @@
 # private network namespace (loopback multicast only). One scenario a run:
 #   drops_jitter      10 % of every message lost and 0–50 ms jitter on every channel, both ways:
 #                     the exploration still completes, no collision.
+#   mixed             5 % drops, 5 % duplicates, 5 % reordered, 2 % with corrupted bytes, 20 ms delay
+#                     + 0–20 ms jitter, both ways: corrupt messages are rejected, the rest completes.
 #   lidar_silence     LIDAR silent for 3 s mid-run: the autonomy halts the robot (its watchdog), then
 #                     resumes when scans return, and completes.
 #   robot_restart     the robot process killed mid-run and started again where it stood (odometry
@@ -14,7 +16,7 @@
 #   faults_over_lcm.sh <mbot_nav> <config dir> <output dir> <scenario>
 set -u
 bin=$1 config=$2 out=$3 scenario=$4
-case $scenario in drops_jitter | lidar_silence | robot_restart | autonomy_restart) ;;
+case $scenario in drops_jitter | mixed | lidar_silence | robot_restart | autonomy_restart) ;;
   *) echo "unknown scenario '$scenario'"; exit 2 ;;
 esac
 if ! unshare -n true 2>/dev/null; then
@@ -32,6 +34,8 @@ unshare -n bash -c '
   relay_args=()
   case $scenario in
     drops_jitter) relay_args=(--set source.drop_rate=0.1 --set source.jitter_ms=50) ;;
+    mixed) relay_args=(--set source.drop_rate=0.05 --set source.duplicate_rate=0.05 --set source.reorder_rate=0.05
+                       --set source.corrupt_rate=0.02 --set source.delay_ms=20 --set source.jitter_ms=20) ;;
     lidar_silence) relay_args=(--set source.silences=LIDAR@20+3) ;;
   esac
   "$bin" --config "$config/fault_relay.ini" --set output.dir="$out/relay" --set source.url="$robot_url" \
@@ -103,6 +107,9 @@ case $scenario in
     grep -q '"completed": true' "$out/robot/score.json" || { echo "FAIL: the referee did not see the exploration completed"; fail=1; }
     grep -qE "relay LIDAR: [0-9]+ received, [0-9]+ relayed, [1-9][0-9]* dropped" "$out/relay.log" ||
       { echo "FAIL: the relay dropped nothing"; fail=1; } ;;
+  mixed)
+    grep -q '"completed": true' "$out/robot/score.json" || { echo "FAIL: the referee did not see the exploration completed"; fail=1; }
+    grep -qE "relay LIDAR: .* [1-9][0-9]* corrupted" "$out/relay.log" || { echo "FAIL: the relay corrupted nothing"; fail=1; } ;;
   lidar_silence)
     grep -q '"completed": true' "$out/robot/score.json" || { echo "FAIL: the referee did not see the exploration completed"; fail=1; }
     grep -q "lcm: no LIDAR" "$out/autonomy.log" || { echo "FAIL: the silence was not noticed"; fail=1; }

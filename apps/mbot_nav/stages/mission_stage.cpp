@@ -3,6 +3,8 @@
 // message (the firmware's 50 Hz), publishes what the mission asks: its state, its paths and the
 // velocity command on MBOT_VEL_CMD (to the simulator, or to a robot over LCM). It does nothing
 // harmful on a log (nobody listens to its commands there). Writes mission.json.
+#include <optional>
+
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/config.hpp"
 #include "mbot/mission/mission.hpp"
@@ -21,6 +23,7 @@ struct MissionStageOptions {
   std::string status_channel = "MISSION_STATUS";
   std::string path_channel = "CONTROLLER_PATH";  // follow: paths sent by a GUI arrive here
   std::string command_channel = "MBOT_VEL_CMD";
+  double status_every_s = 0.0;  // also repeat the last state this often (a lossy link); 0: on change only
 };
 
 class MissionStage : public Stage {
@@ -44,6 +47,7 @@ class MissionStage : public Stage {
         for (const mission::MissionOutput& out : mission_->OnOdometry(ev.t_us, std::get<motion::Pose2D>(ev.payload))) {
           Publish(ev.t_us, out);
         }
+        RepeatStatus(ev.t_us);
         return;
       default: return;
     }
@@ -70,6 +74,8 @@ class MissionStage : public Stage {
     if (!bus_) return;
     if (const auto* s = std::get_if<mission::MissionStatus>(&out)) {
       bus_->Emit(this, Event{t_us, t_us, o_.status_channel, EventKind::kMissionStatus, *s});
+      last_status_ = *s;
+      last_status_us_ = t_us;
     } else if (const auto* p = std::get_if<mission::PathOut>(&out)) {
       bus_->Emit(this, Event{t_us, t_us, o_.path_channel, EventKind::kPath, drivers::Path{p->poses}});
     } else {
@@ -79,9 +85,19 @@ class MissionStage : public Stage {
     }
   }
 
+  // Over a lossy link a state sent once can be lost ("completed" above all): repeat the last one.
+  void RepeatStatus(int64_t t_us) {
+    if (o_.status_every_s <= 0 || !last_status_ || !bus_) return;
+    if (t_us - last_status_us_ < static_cast<int64_t>(o_.status_every_s * 1e6)) return;
+    last_status_us_ = t_us;
+    bus_->Emit(this, Event{t_us, t_us, o_.status_channel, EventKind::kMissionStatus, *last_status_});
+  }
+
   MissionStageOptions o_;
   std::unique_ptr<mission::Mission> mission_;
   Bus* bus_ = nullptr;
+  std::optional<mission::MissionStatus> last_status_;
+  int64_t last_status_us_ = 0;
 };
 
 }  // namespace
@@ -97,6 +113,10 @@ StageType MissionStageType() {
             o.path_channel = s.GetString("path_channel", o.path_channel,
                                          "paths go out here; with task = follow, a GUI's paths come in here");
             o.command_channel = s.GetString("command_channel", o.command_channel, "velocity commands go out here");
+            o.status_every_s = s.GetDouble("status_every_s", o.status_every_s,
+                                           "also repeat the last state this often, for a lossy link (0: only on "
+                                           "change) [s]",
+                                           0.0, 3600.0);
             return std::make_unique<MissionStage>(o);
           }};
 }
