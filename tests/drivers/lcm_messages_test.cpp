@@ -11,6 +11,7 @@
 #include "mbot_legacy/mbot_motor_command_t.hpp"
 #include "mbot_legacy/pose_xyt_t.hpp"
 #include "mbot_w23/mbot_wheel_ctrl_t.hpp"
+#include "mbot_w23/occupancy_grid_t.hpp"
 
 namespace mbot::drivers {
 namespace {
@@ -96,6 +97,26 @@ TEST(LcmMessages, StringLengthsAreCheckedBeforeLcmGenDecodes) {
     EXPECT_FALSE(lcm_adapter::Decode("SLAM_STATUS", bad.data(), bad.size(), ChannelRoles{}, &ev, &error));
     EXPECT_NE(error.find("map_path length"), std::string::npos) << error;
   }
+}
+
+// Found by the 60 s fuzz run: the same overflow in the Winter 2023 grid's slam_map_location, whose
+// length sits at byte 44 (after the fingerprint, utime, origin, resolution, size, count and mode).
+TEST(LcmMessages, Winter2023GridStringLengthIsChecked) {
+  mbot_w23::occupancy_grid_t g{};
+  g.utime = 1;
+  g.meters_per_cell = 0.05f;
+  g.width = g.height = 1;
+  g.num_cells = 1;
+  g.cells = {0};
+  g.slam_map_location = "map";
+  std::vector<uint8_t> bytes(g.getEncodedSize());
+  g.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  Event ev;
+  std::string error;
+  ASSERT_TRUE(lcm_adapter::Decode("SLAM_MAP", bytes.data(), bytes.size(), ChannelRoles{}, &ev, &error)) << error;
+  bytes[44] = 0x80, bytes[45] = bytes[46] = bytes[47] = 0;
+  EXPECT_FALSE(lcm_adapter::Decode("SLAM_MAP", bytes.data(), bytes.size(), ChannelRoles{}, &ev, &error));
+  EXPECT_NE(error.find("slam_map_location length"), std::string::npos) << error;
 }
 
 TEST(LcmMessages, OdometryPoseRoundTrips) {

@@ -386,7 +386,7 @@ std::map<int64_t, Entry> BuildTable() {
   add(mbot_w23::occupancy_grid_t::getHash(), "occupancy_grid_t", kW23,
       [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
         // num_cells is followed by slam_mode and a string before the cells: check against the rest.
-        if (!CheckString(d, n, 48, "slam_map_location", err)) return false;
+        if (!CheckString(d, n, 44, "slam_map_location", err)) return false;
         return DecodeGrid<mbot_w23::occupancy_grid_t>(d, n, 36, ev, err);
       });
 
