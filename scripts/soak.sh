@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The one-hour soak (config/soak.ini: an hour of simulated Warehouse rounds in one process), then its
+# The one-hour soak (config/soak.ini: an hour of simulated time in one process — exploration with
+# full SLAM, then Warehouse rounds on the map it made), then its
 # curves from slam_scans.csv: per 5 simulated minutes, the median and 95th-percentile time per scan
 # and the resident memory. Fails when memory grows by more than 64 MB from the first 5 minutes to
 # the last: a buffer that grows with every scan (like the 9.6 KB a scan the consistency metric once
@@ -16,7 +17,10 @@ bin=${MBOT_NAV:-build/apps/mbot_nav/mbot_nav}
   { tail -20 "$out.log"; echo "soak.sh: the run failed" >&2; exit 1; }
 grep -E "^done:|slam: [0-9]+ scans" "$out.log"
 rounds=$(sed -n 's/.*"rounds": \([0-9]*\).*/\1/p' "$out/mission.json")
-echo "warehouse rounds: $rounds"
+echo "warehouse rounds after exploring: $rounds"
+grep -q "mission: initializing (explored; now the warehouse)" "$out.log" ||
+  { echo "soak.sh: FAIL: the exploration did not complete" >&2; exit 1; }
+[ "${rounds:-0}" -ge 2 ] || { echo "soak.sh: FAIL: fewer than two Warehouse rounds in the hour" >&2; exit 1; }
 awk -F, 'NR > 1 {
     bin = int($1 / 300); if (bin > 0 && $1 == bin * 300) bin--  # 3600.0 s is the last of the hour
     n[bin]++; v[bin, n[bin]] = $14; if ($15 > 0) rss[bin] = $15; if (bin > last) last = bin

@@ -33,7 +33,14 @@ const char* ToString(TaskKind kind) {
 }
 
 Mission::Mission(const MissionOptions& options, uint64_t seed)
-    : o_(options), task_(MakeTask(o_, seed)), controller_(o_.controller), seed_(seed) {}
+    : o_(options), task_(MakeTask(o_, seed)), controller_(o_.controller), seed_(seed) {
+  if (o_.explore_first && o_.task != TaskKind::kExplore) {
+    MissionOptions explore = o_;
+    explore.task = TaskKind::kExplore;
+    task_ = MakeTask(explore, seed);
+    exploring_first_ = true;
+  }
+}
 
 Mission::~Mission() = default;
 
@@ -80,6 +87,12 @@ std::vector<MissionOutput> Mission::OnOdometry(int64_t t_us, const Pose2D& raw_o
   } else if ((t_us - slam_.t_us) * 1e-6 > o_.max_pose_age_s) {
     ++stale_stops_;
     SetState(status_.state, "SLAM pose stale: stopped");
+    Hold();
+  } else if (status_.state == MissionState::kCompleted && exploring_first_) {
+    exploring_first_ = false;  // explored and home: now the task, on the map just made
+    task_ = MakeTask(o_, seed_);
+    final_leg_ = false;
+    SetState(MissionState::kInitializing, std::string("explored; now the ") + ToString(o_.task));
     Hold();
   } else if (status_.state == MissionState::kCompleted && rounds_ < o_.repeat) {
     ++rounds_;  // a soak: the task again, with the next seed (a warehouse's next order)

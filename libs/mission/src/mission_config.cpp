@@ -54,6 +54,8 @@ MissionOptions ParseMissionOptions(config::Section& s) {
                                        "start the task again this many times once it completes (a soak run; the "
                                        "warehouse takes the next seed's order each round)",
                                        0, 1000000));
+  o.explore_first = s.GetBool("explore_first", o.explore_first,
+                              "explore and return home first, then run the task on the map made (full SLAM)");
   o.controller = motion::ParseMotionControllerOptions(s);
   o.exploration = planning::ParseExplorationOptions(s);
   o.explore_period_s =

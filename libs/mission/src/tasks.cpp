@@ -102,8 +102,9 @@ class WarehouseTask : public Task {
   }
 
   bool Step(Mission& m, const Pose2D& pose) override {
+    // Localized in the known map, or mapping (full SLAM, after exploring: its pose is tracked).
     const std::optional<mapping::SlamState> slam = m.slam_state();
-    if (slam != mapping::SlamState::kLocalized) {
+    if (slam != mapping::SlamState::kLocalized && slam != mapping::SlamState::kMapping) {
       m.SetState(MissionState::kLocalizing, "waiting for SLAM to localize (it says " +
                                                 std::string(slam ? mapping::ToString(*slam) : "nothing yet") + ")");
       if (m.final_leg()) need_plan_ = true;  // the path was planned from a pose no longer trusted

@@ -37,8 +37,9 @@ struct MissionOptions {
   // deliveries follows from them and the seed (warehouse_rules.hpp).
   std::vector<motion::Pose2D> targets;
   std::vector<motion::Pose2D> dropoffs;
-  int deliveries = 0;  // warehouse: make only the first this many of the seed's order (0: all the rules ask)
-  int repeat = 0;      // start the task again this many times once it completes (soak runs)
+  int deliveries = 0;          // warehouse: make only the first this many of the seed's order (0: all the rules ask)
+  int repeat = 0;              // start the task again this many times once it completes (soak runs)
+  bool explore_first = false;  // explore (and return home) before the task: its map is the task's
   motion::MotionControllerOptions controller;
   planning::ExplorationOptions exploration;
   double explore_period_s = 0.25;  // explorer updates at most this often [s]
@@ -137,6 +138,7 @@ class Mission {
   bool final_leg_ = false;  // the path ends at goal_, where the robot must stop within the tolerances
   uint64_t seed_ = 0;
   int rounds_ = 0;  // completed rounds started again (repeat)
+  bool exploring_first_ = false;
   motion::Pose2D goal_;
   motion::Pose2D stall_goal_{1e9, 1e9, 0};  // the goal the stall budget is for
   MissionStatus status_;
