@@ -39,6 +39,21 @@ void WriteScansCsv(const std::string& path, const std::vector<ScanRecord>& recor
 
 }  // namespace
 
+void PairRecordsAndTrim(SlamInputs* inputs, std::vector<ScanRecord>* records, RecordPairing* paired,
+                        int64_t scan_start_us, int64_t max_gap_us) {
+  auto pair = [&](const std::vector<TimedPose>& series, size_t* next, std::optional<Pose2D> ScanRecord::*field) {
+    while (*next < records->size() && !series.empty() && series.back().t_us >= (*records)[*next].t_us) {
+      Pose2D p;
+      if (motion::InterpolateAt(series, (*records)[*next].t_us, max_gap_us, &p)) (*records)[*next].*field = p;
+      ++*next;
+    }
+    return *next < records->size() ? (*records)[*next].t_us : INT64_MAX;
+  };
+  const int64_t waiting = std::min(pair(inputs->ground_truth(), &paired->truth, &ScanRecord::truth),
+                                   pair(inputs->reference(), &paired->reference, &ScanRecord::reference));
+  inputs->TrimBefore(std::min(waiting, scan_start_us) - 2 * max_gap_us);
+}
+
 void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& run) {
   const SlamStageOptions& options = *run.options;
   const std::vector<ScanRecord>& records = *run.records;
@@ -102,7 +117,7 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& ru
     model.SetMap(map);
     double sum = 0;
     for (size_t i = 0; i < run.scan_points->size(); ++i)
-      sum += model.InlierFraction(records[(*run.scan_points)[i].record].slam, (*run.scan_points)[i].points);
+      sum += model.InlierFraction(records[(*run.scan_points)[i].index].slam, (*run.scan_points)[i].value);
     consistency = sum / run.scan_points->size();
   }
   std::vector<double> update_ms, filter_ms, ess;

@@ -10,9 +10,11 @@
 #include <vector>
 
 #include "../stage.hpp"
+#include "mbot/common/strided_sample.hpp"
 #include "mbot/mapping/slam.hpp"
 #include "mbot/motion/pose2d.hpp"
 #include "slam_config.hpp"
+#include "slam_inputs.hpp"
 
 namespace mbot::app {
 
@@ -30,11 +32,19 @@ struct ScanRecord {
   std::optional<motion::Pose2D> truth, reference;
 };
 
-// A scan kept for the map-consistency metric: its record's index and its points.
-struct KeptScan {
-  size_t record = 0;
-  mapping::ScanPoints points;
+// The scans kept for the map-consistency metric: each one's record index and points.
+using ScanSample = StridedSample<mapping::ScanPoints>;
+
+// Records before these have their truth and reference poses.
+struct RecordPairing {
+  size_t truth = 0, reference = 0;
 };
+
+// Records take their truth and reference poses once those series have passed their time; the
+// series are then trimmed behind both the records still waiting and the scan starting at
+// `scan_start_us`, so a run of any length keeps bounded memory.
+void PairRecordsAndTrim(SlamInputs* inputs, std::vector<ScanRecord>* records, RecordPairing* paired,
+                        int64_t scan_start_us, int64_t max_gap_us);
 
 struct SlamRun {
   const SlamStageOptions* options = nullptr;
@@ -43,7 +53,7 @@ struct SlamRun {
   const std::vector<motion::TimedPose>* ground_truth = nullptr;  // the recent part, for records not yet paired
   const std::vector<motion::TimedPose>* reference = nullptr;
   const mapping::SlamEventTracker* events = nullptr;
-  const std::vector<KeptScan>* scan_points = nullptr;  // a uniform sample of the records, for consistency
+  const std::vector<ScanSample::Item>* scan_points = nullptr;  // a uniform sample of the records, for consistency
   const std::vector<motion::Pose2D>* particle_snapshots = nullptr;
   int64_t first_t_us = -1, last_t_us = -1, kidnapped_at_us = -1;
   int skipped_scans = 0;

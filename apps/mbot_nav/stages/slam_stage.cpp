@@ -68,7 +68,7 @@ class SlamStage : public Stage {
     }
     WriteSlamOutputs(ctx, interrupted,
                      SlamRun{&options_, &slam_, &records_, &inputs_->ground_truth(), &inputs_->reference(), &events_,
-                             &scan_points_, &particle_snapshots_, inputs_->first_t_us(), inputs_->last_t_us(),
+                             &scan_sample_.items(), &particle_snapshots_, inputs_->first_t_us(), inputs_->last_t_us(),
                              inputs_->kidnapped_at_us(), skipped_scans_, wall_s});
   }
 
@@ -109,7 +109,7 @@ class SlamStage : public Stage {
     }
     const bool mapping_only = options_.slam.mode == mapping::SlamMode::kMappingOnly;
     const mapping::SlamStep step = slam_.ProcessScan(rays, end_pose, mapping_only ? &end_pose : nullptr);
-    KeepForConsistency(rays);
+    if (scan_sample_.Wants(records_.size())) scan_sample_.Add(records_.size(), consistency_model_.Prepare(rays));
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall0).count();
 
     ScanRecord r;
@@ -130,38 +130,7 @@ class SlamStage : public Stage {
     }
     TrackEvents(r);
     MaybeCheckpoint(r);
-    PairAndTrim(t_end - duration);
-  }
-
-  // Records take their truth and reference poses once those series have passed their time; the
-  // series are then trimmed behind both the records still waiting and the scan in progress.
-  void PairAndTrim(int64_t scan_start_us) {
-    const int64_t max_gap = static_cast<int64_t>(options_.max_pose_gap_s * 1e6);
-    auto pair = [&](const std::vector<motion::TimedPose>& series, size_t* next, bool truth) {
-      while (*next < records_.size() && !series.empty() && series.back().t_us >= records_[*next].t_us) {
-        ScanRecord& r = records_[*next];
-        Pose2D p;
-        if (motion::InterpolateAt(series, r.t_us, max_gap, &p)) (truth ? r.truth : r.reference) = p;
-        ++*next;
-      }
-      return *next < records_.size() ? records_[*next].t_us : INT64_MAX;
-    };
-    const int64_t waiting = std::min(pair(inputs_->ground_truth(), &truth_paired_, true),
-                                     pair(inputs_->reference(), &reference_paired_, false));
-    inputs_->TrimBefore(std::min(waiting, scan_start_us) - 2 * max_gap);
-  }
-
-  void KeepForConsistency(const std::vector<mapping::ScanRay>& rays) {
-    const size_t index = records_.size();  // the record this scan is about to become
-    if (index % scan_stride_ != 0) return;
-    if (scan_points_.size() == kMaxKeptScans) {
-      size_t kept = 0;
-      for (size_t i = 0; i < scan_points_.size(); i += 2) scan_points_[kept++] = std::move(scan_points_[i]);
-      scan_points_.resize(kept);
-      scan_stride_ *= 2;
-      if (index % scan_stride_ != 0) return;
-    }
-    scan_points_.push_back({index, consistency_model_.Prepare(rays)});
+    PairRecordsAndTrim(&*inputs_, &records_, &paired_, t_end - duration, max_gap);
   }
 
   // The map and pose, every checkpoint_every_s of the stream's time, for a run that has to resume.
@@ -244,20 +213,16 @@ class SlamStage : public Stage {
   mapping::Slam slam_;
   mapping::SlamEventTracker events_;
   double rss_mb_ = 0;
-  size_t truth_paired_ = 0, reference_paired_ = 0;  // records before these have their poses
-  std::string checkpoint_path_;                     // empty: no checkpoints
+  RecordPairing paired_;
+  std::string checkpoint_path_;  // empty: no checkpoints
   int64_t last_checkpoint_us_ = -1;
   std::optional<SlamInputs> inputs_;
   Bus* bus_ = nullptr;
   std::optional<mapping::SlamState> published_state_;
   int skipped_scans_ = 0;
   std::vector<ScanRecord> records_;
-  // The consistency metric's sample: every scan_stride_-th scan, at most kMaxKeptScans of them (when
-  // full, every other one goes and the stride doubles), so a run of any length keeps bounded memory.
-  static constexpr size_t kMaxKeptScans = 2048;
   mapping::SensorModel consistency_model_{mapping::SensorModelOptions{}};
-  std::vector<KeptScan> scan_points_;  // a uniform sample of the records, for the map-consistency metric
-  size_t scan_stride_ = 1;
+  ScanSample scan_sample_{2048};  // the map-consistency metric's scans: bounded for any run length
   std::vector<Pose2D> particle_snapshots_;
   std::chrono::steady_clock::time_point wall_start_;
 };

@@ -13,7 +13,12 @@
 
 namespace mbot::drivers {
 
-namespace {}  // namespace
+std::string LcmChannelPattern(const std::string& channel) {
+  std::string exact;
+  for (const char ch : channel)
+    exact += std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' ? std::string(1, ch) : std::string("\\") + ch;
+  return exact;
+}
 
 int64_t WallClockUs() {
   return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
@@ -73,11 +78,7 @@ LcmNode::LcmNode(const std::string& url, const std::vector<std::string>& channel
   if (!impl_->lcm.good()) throw std::runtime_error("lcm: cannot open '" + url + "'");
   impl_->node = this;
   for (const std::string& c : channels) {
-    // LCM takes the name as a regular expression: anchor it to this channel alone.
-    std::string exact;
-    for (const char ch : c)
-      exact += std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' ? std::string(1, ch) : std::string("\\") + ch;
-    if (!impl_->lcm.subscribe(exact, &Impl::OnMessage, impl_.get())) {
+    if (!impl_->lcm.subscribe(LcmChannelPattern(c), &Impl::OnMessage, impl_.get())) {
       throw std::runtime_error("lcm: cannot subscribe to '" + c + "' on '" + url + "'");
     }
     stats_[c];

@@ -23,13 +23,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::string ExactChannel(const std::string& c) {
-  std::string exact;
-  for (const char ch : c)
-    exact += std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' ? std::string(1, ch) : std::string("\\") + ch;
-  return exact;
-}
-
 }  // namespace
 
 struct LcmFaultRelay::Impl {
@@ -67,8 +60,8 @@ struct LcmFaultRelay::Impl {
     if (!autonomy.good()) throw std::runtime_error("lcm_relay: cannot open autonomy_url '" + o.autonomy_url + "'");
     up = {this, true};
     down = {this, false};
-    for (const std::string& c : o.robot_to_autonomy) robot.subscribe(ExactChannel(c), &Side::OnMessage, &up);
-    for (const std::string& c : o.autonomy_to_robot) autonomy.subscribe(ExactChannel(c), &Side::OnMessage, &down);
+    for (const std::string& c : o.robot_to_autonomy) robot.subscribe(LcmChannelPattern(c), &Side::OnMessage, &up);
+    for (const std::string& c : o.autonomy_to_robot) autonomy.subscribe(LcmChannelPattern(c), &Side::OnMessage, &down);
     faulty.insert(o.faults.channels.begin(), o.faults.channels.end());
   }
 

@@ -9,11 +9,11 @@
 #include <csignal>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <new>
 #include <stdexcept>
 
 #include "mbot/common/files.hpp"
+#include "mbot/common/process.hpp"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define MBOT_ASAN 1
@@ -28,14 +28,6 @@
 
 namespace mbot::drivers {
 namespace {
-
-// The process's mapped address space now, from /proc/self/statm (pages), or 0 when unknown.
-uint64_t AddressSpaceBytes() {
-  std::ifstream in("/proc/self/statm");
-  uint64_t pages = 0;
-  if (!(in >> pages)) return 0;
-  return pages * static_cast<uint64_t>(sysconf(_SC_PAGESIZE));
-}
 
 // Child side: a crash or an allocation failure ends the child quietly (the parent reports it), and
 // the address space is bounded to what it maps now plus `budget`. Under AddressSanitizer (and a

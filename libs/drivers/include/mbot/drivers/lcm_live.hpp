@@ -72,6 +72,9 @@ class LcmNode {
 // Wall-clock time in µs since the epoch.
 int64_t WallClockUs();
 
+// LCM takes a channel name as a regular expression: this one matches `channel` alone.
+std::string LcmChannelPattern(const std::string& channel);
+
 // The bytes LcmNode::Publish sends for `event` (empty when it has no LCM message).
 std::vector<uint8_t> EncodeEvent(const Event& event);
 
