@@ -11,7 +11,7 @@ const std::vector<StageType>& StageTypes() {
                                 AStarTestStageType(),      MovingAiBenchmarkStageType(), ExplorationStageType(),
                                 SlamStageType(),           OdometryStageType(),          MotorCalibrationStageType(),
                                 ActionModelFitStageType(), MissionStageType(),           RefereeStageType(),
-                                RecorderStageType(),       LcmBridgeStageType()};
+                                RecorderStageType(),       LcmBridgeStageType(),         MazeGeneratorStageType()};
     std::sort(t.begin(), t.end(), [](const StageType& a, const StageType& b) { return a.name < b.name; });
     return t;
   }();

@@ -19,5 +19,6 @@ StageType MissionStageType();
 StageType RefereeStageType();
 StageType RecorderStageType();
 StageType LcmBridgeStageType();
+StageType MazeGeneratorStageType();
 
 }  // namespace mbot::app

@@ -101,6 +101,14 @@ bool IsCases(const std::string& path, const char* type) {
   return IsPlanningCasesPath(path, &cases) && cases == type;
 }
 
+// source type `none`: nothing to read.
+class NoSource : public Source {
+ public:
+  std::optional<Event> Next() override { return std::nullopt; }
+  double Progress() const override { return 1.0; }
+  std::string Format() const override { return "no input"; }
+};
+
 // libs/drivers' own types; detect_order < 0 may name a folder, the others need a regular file.
 std::deque<SourceType> BuiltInTypes() {
   std::deque<SourceType> t;
@@ -127,6 +135,8 @@ std::deque<SourceType> BuiltInTypes() {
   t.push_back({"lcm_live", "a robot (or the simulated one) on the LCM bus, in wall-clock time; path is the LCM url",
                nullptr, 0, [](config::Section& s, SourceOptions* o) { o->live = ParseLiveSourceOptions(s); },
                [](const SourceOptions& o) { return std::make_unique<LcmLiveSource>(o); }});
+  t.push_back({"none", "no input: for stages that make their own output (maze_generator)", nullptr, 0, nullptr,
+               [](const SourceOptions&) { return std::make_unique<NoSource>(); }});
   t.push_back({"lcm_relay",
                "a fault-injecting relay between the robot's LCM group (url) and the autonomy's (relay_url): drops, "
                "delay, jitter, duplicates, reordering, corruption, silences",
@@ -168,7 +178,9 @@ SourceOptions ParseSourceOptions(config::Section& s) {
     o.path = s.GetString("url", kDefaultLcmUrl,
                          "lcm_live: the LCM URL (ttl=0 keeps the traffic on this machine); lcm_relay: the robot's");
   }
-  if (!live) {
+  if (o.type == "none") {
+    o.path = s.GetPath("path", "", "");
+  } else if (!live) {
     o.path = s.RequirePath("path",
                            "the dataset to read (LCM log, MRPT rawlog, CARMEN log, map file, botlab A* poses file or "
                            "folder, Moving AI .scen), or the simulator's world (.arena or a map)");
@@ -238,7 +250,7 @@ std::unique_ptr<Source> OpenSource(const SourceOptions& options) {
   const SourceType* t = FindSourceType(type);
   if (!t) throw std::runtime_error("source type '" + type + "' is not known");
   // Only the A* cases come as a folder; a folder anywhere else would read as an empty file.
-  const bool bus = type == "lcm_live" || type == "lcm_relay";
+  const bool bus = type == "lcm_live" || type == "lcm_relay" || type == "none";
   if (type != "astar_cases" && !bus && std::filesystem::is_directory(options.path)) {
     throw std::runtime_error(options.path + ": is a directory, not a " + type + " file");
   }
