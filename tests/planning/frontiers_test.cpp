@@ -23,6 +23,28 @@ TEST(FrontiersTest, BorderBetweenFreeAndUnknownGroupedIntoRegions) {
   EXPECT_EQ(FindFrontiers(g, {5, 1.0}).size(), 1u);  // min_cells drops the island
 }
 
+// A corridor seen only by a few grazing rays: faint free cells (log-odds -3) fading into unknown.
+// Counted as free, its frontier would lie deep in the faint band, out of reach; counted as unknown
+// (above free_threshold), the frontier is at its mouth, where the well-seen room ends.
+TEST(FrontiersTest, FaintCellsCountAsUnknownAtTheThresholds) {
+  OccupancyGrid g(40, 20, 0.05, 0, 0, 0);
+  for (int y = 0; y < 20; ++y) {
+    for (int x = 0; x < 20; ++x) g.at(x, y) = -60;  // the room
+    for (int x = 20; x < 30; ++x) g.at(x, y) = -3;  // the faint band
+  }
+  const std::vector<Frontier> f = FindFrontiers(g, {1, 1.0});
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_NEAR(f[0].centroid_x, 19.5 * 0.05, 1e-9);  // the room's last column
+  FrontierOptions faint_is_free{1, 1.0, -1, 1};     // the old rule: any negative log-odds is free
+  const std::vector<Frontier> old = FindFrontiers(g, faint_is_free);
+  ASSERT_EQ(old.size(), 1u);
+  EXPECT_NEAR(old[0].centroid_x, 29.5 * 0.05, 1e-9);  // the end of the faint band
+  // A weakly hit cell (log-odds 3) is not an obstacle either at occupied_threshold 5.
+  g.at(10, 10) = 3;
+  EXPECT_EQ(FindFrontiers(g, {1, 1.0, -20, 5}).size(), 2u);
+  EXPECT_EQ(FindFrontiers(g, {1, 1.0}).size(), 1u);
+}
+
 TEST(FrontiersTest, OccupiedCellsAreNeverFrontiers) {
   OccupancyGrid g(10, 10, 0.05, 0, 0, 0);
   for (int y = 0; y < 10; ++y) g.at(3, y) = 100;

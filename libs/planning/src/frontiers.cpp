@@ -9,12 +9,13 @@ namespace mbot::planning {
 std::vector<Frontier> FindFrontiers(const mapping::OccupancyGrid& map, const FrontierOptions& options) {
   const int w = map.width(), h = map.height();
   const auto& cells = map.cells();
+  const int free_at = options.free_threshold, occupied_at = options.occupied_threshold;
+  auto unknown = [&](size_t i) { return cells[i] > free_at && cells[i] < occupied_at; };
   auto is_frontier = [&](int x, int y) {
-    if (cells[static_cast<size_t>(y) * w + x] >= 0) return false;
-    return (x > 0 && cells[static_cast<size_t>(y) * w + x - 1] == 0) ||
-           (x + 1 < w && cells[static_cast<size_t>(y) * w + x + 1] == 0) ||
-           (y > 0 && cells[static_cast<size_t>(y - 1) * w + x] == 0) ||
-           (y + 1 < h && cells[static_cast<size_t>(y + 1) * w + x] == 0);
+    const size_t i = static_cast<size_t>(y) * w + x;
+    if (cells[i] > free_at) return false;
+    return (x > 0 && unknown(i - 1)) || (x + 1 < w && unknown(i + 1)) || (y > 0 && unknown(i - w)) ||
+           (y + 1 < h && unknown(i + w));
   };
   std::vector<uint8_t> state(cells.size(), 0);  // 1: frontier, 2: already grouped
   for (int y = 0; y < h; ++y) {
@@ -61,23 +62,24 @@ std::vector<Frontier> FindFrontiers(const mapping::OccupancyGrid& map, const Fro
   return out;
 }
 
-namespace {
-
-// True when the straight line between the centres of cells a and b crosses no occupied cell
-// (unknown cells do not block: the frontier's centroid usually lies in unknown space). Sampled at a
-// quarter cell, so a one-cell wall is never stepped over.
-bool SeesThrough(const mapping::OccupancyGrid& map, int ax, int ay, int bx, int by) {
-  const int steps = 4 * std::max(std::abs(bx - ax), std::abs(by - ay));
-  for (int k = 1; k < steps; ++k) {
-    const double t = double(k) / steps;
-    const int x = static_cast<int>(std::lround(ax + t * (bx - ax))),
-              y = static_cast<int>(std::lround(ay + t * (by - ay)));
-    if (map.at(x, y) > 0) return false;
+FrontierLayers ComputeFrontierLayers(const mapping::OccupancyGrid& map, const FrontierOptions& options) {
+  FrontierLayers layers;
+  const int w = map.width();
+  auto centre = [&](int i) {
+    motion::Pose2D p;
+    map.CellToWorld(i % w, i / w, &p.x, &p.y);
+    return p;
+  };
+  const auto& cells = map.cells();
+  for (int i = 0; i < static_cast<int>(cells.size()); ++i) {
+    if (cells[i] != 0 && cells[i] > options.free_threshold && cells[i] < options.occupied_threshold)
+      layers.faint.push_back(centre(i));
   }
-  return true;
+  for (const Frontier& f : FindFrontiers(map, options)) {
+    for (int c : f.cells) layers.frontier.push_back(centre(c));
+  }
+  return layers;
 }
-
-}  // namespace
 
 std::vector<FrontierGoal> RankFrontierGoals(const std::vector<Frontier>& frontiers, const motion::Pose2D& robot,
                                             const mapping::OccupancyGrid& map, AStarPlanner& planner,
@@ -88,34 +90,43 @@ std::vector<FrontierGoal> RankFrontierGoals(const std::vector<Frontier>& frontie
   if (frontiers.empty()) return goals;
   const std::vector<double> cost = planner.CostsFrom(robot, clearance_m);
   const int w = map.width(), h = map.height();
-  const int radius_cells = static_cast<int>(std::ceil(options.search_radius_m / map.resolution()));
+  const auto& cells = map.cells();
+  const int radius_cells = static_cast<int>(std::floor(options.search_radius_m / map.resolution() + 1e-9));
+  // Breadth-first from the frontier's cells through mapped free space (log-odds < 0, faint cells
+  // too), ring by ring: the first ring holding cells the robot can reach wins, and of those the one
+  // it reaches at least cost. Walls and unknown space stop the search, so the goal is never a cell
+  // behind a wall that is near the frontier as the crow flies but shows nothing of it; and a
+  // frontier is judged by its nearest cell, not its centroid (which a long frontier, or one along a
+  // faint band, may put inside a wall).
+  std::vector<int> ring_of(cells.size(), -1), ring, next;
   for (int i = 0; i < static_cast<int>(frontiers.size()); ++i) {
     const Frontier& f = frontiers[i];
-    int cx, cy;
-    map.WorldToCell(f.centroid_x, f.centroid_y, &cx, &cy);
-    int best = -1, best_blind = -1;
-    double best_d2 = std::numeric_limits<double>::infinity(), best_blind_d2 = best_d2;
-    // Rings of growing radius around the centroid; the first ring holding reachable cells that
-    // see the centroid (no wall between) wins, the cell nearest the centroid within it (and the
-    // next ring, which can hold nearer cells by Euclidean distance) is taken. A cell on the other
-    // side of a wall is nearer by distance but shows nothing of the frontier: it is used only when
-    // no reachable cell within the search radius sees the centroid.
-    for (int r = 0; r <= radius_cells && double(r) * r < best_d2; ++r) {
-      for (int dy = -r; dy <= r; ++dy) {
-        for (int dx = -r; dx <= r; ++dx) {
-          if (std::max(std::abs(dx), std::abs(dy)) != r) continue;
-          const int x = cx + dx, y = cy + dy;
-          if (x < 0 || y < 0 || x >= w || y >= h) continue;
-          const double d2 = double(dx) * dx + double(dy) * dy;
-          if (d2 > double(radius_cells) * radius_cells) continue;
-          const int n = y * w + x;
-          if (!std::isfinite(cost[n]) || d2 >= best_d2) continue;
-          if (d2 < best_blind_d2) best_blind_d2 = d2, best_blind = n;
-          if (SeesThrough(map, x, y, cx, cy)) best_d2 = d2, best = n;
+    ring.assign(f.cells.begin(), f.cells.end());
+    std::vector<int> touched = ring;
+    for (int c : ring) ring_of[c] = i;
+    int best = -1;
+    for (int r = 0; r <= radius_cells && !ring.empty() && best < 0; ++r) {
+      for (int c : ring) {
+        if (std::isfinite(cost[c]) && (best < 0 || cost[c] < cost[best])) best = c;
+      }
+      next.clear();
+      for (int c : ring) {
+        const int cx = c % w, cy = c / w;
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int nx = cx + dx, ny = cy + dy;
+            if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+            const int n = ny * w + nx;
+            if (ring_of[n] == i || cells[n] >= 0) continue;
+            ring_of[n] = i;
+            touched.push_back(n);
+            next.push_back(n);
+          }
         }
       }
+      ring.swap(next);
     }
-    if (best < 0) best = best_blind;
+    for (int c : touched) ring_of[c] = -1;
     if (best < 0) {
       if (unreachable) unreachable->push_back(i);
       continue;

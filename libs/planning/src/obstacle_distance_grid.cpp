@@ -18,9 +18,11 @@ ObstacleDistanceGrid::ObstacleDistanceGrid(const mapping::OccupancyGrid& map, co
   std::vector<uint8_t> obstacle(map.cells().size());
   const int threshold = options.occupied_threshold;
   const bool separate_unknown = options.unknown_is_obstacle && options.unknown_margin_m > 0;
+  const int free_at = std::min(options.free_threshold, threshold);
+  auto is_unknown = [&](int c) { return c > free_at && c <= threshold; };
   for (size_t i = 0; i < obstacle.size(); ++i) {
     const int c = map.cells()[i];
-    obstacle[i] = c > threshold || (options.unknown_is_obstacle && !separate_unknown && c == 0);
+    obstacle[i] = c > threshold || (options.unknown_is_obstacle && !separate_unknown && is_unknown(c));
   }
   dist_ = SquaredDistanceTransform(obstacle, width_, height_);
   const float res = static_cast<float>(resolution_);
@@ -28,7 +30,7 @@ ObstacleDistanceGrid::ObstacleDistanceGrid(const mapping::OccupancyGrid& map, co
   if (!separate_unknown) return;
   // Unknown space counts as an obstacle unknown_margin_m farther than it is; an unknown cell itself
   // stays at 0, so it is never entered whatever the margin.
-  for (size_t i = 0; i < obstacle.size(); ++i) obstacle[i] = map.cells()[i] == 0;
+  for (size_t i = 0; i < obstacle.size(); ++i) obstacle[i] = is_unknown(map.cells()[i]);
   const std::vector<float> unknown = SquaredDistanceTransform(obstacle, width_, height_);
   const float margin = static_cast<float>(options.unknown_margin_m);
   for (size_t i = 0; i < dist_.size(); ++i) {

@@ -39,6 +39,10 @@ ObstacleDistanceOptions ParseObstacleDistanceOptions(config::Section& s, const O
                   "with unknown_is_obstacle: unknown cells count as this much farther than they are [m]", 0.0, 10.0);
   o.occupied_threshold = static_cast<int>(
       s.GetInt("occupied_threshold", d.occupied_threshold, "cells with log-odds above this are obstacles", -127, 126));
+  o.free_threshold = static_cast<int>(s.GetInt("free_threshold", d.free_threshold,
+                                               "with unknown_is_obstacle: cells are free at or below this log-odds, "
+                                               "unknown between it and occupied_threshold",
+                                               -127, -1));
   return o;
 }
 
@@ -48,6 +52,13 @@ FrontierOptions ParseFrontierOptions(config::Section& s, const FrontierOptions& 
       s.GetInt("min_frontier_cells", d.min_cells, "frontier regions with fewer cells are ignored", 1, 1000000));
   o.search_radius_m = s.GetDouble("frontier_search_radius_m", d.search_radius_m,
                                   "radius searched around a frontier's centroid for a reachable cell [m]", 0.0, 100.0);
+  o.free_threshold = static_cast<int>(s.GetInt(
+      "frontier_free_threshold", d.free_threshold,
+      "frontiers: a cell is free at or below this log-odds; cells between this and frontier_occupied_threshold "
+      "(never seen, or faint from a few grazing rays) count as unknown",
+      -127, 0));
+  o.occupied_threshold = static_cast<int>(s.GetInt("frontier_occupied_threshold", d.occupied_threshold,
+                                                   "frontiers: a cell is occupied at or above this log-odds", 1, 127));
   return o;
 }
 
@@ -73,10 +84,16 @@ ExplorationOptions ParseExplorationOptions(config::Section& s, const Exploration
                               "how long an unreachable or unresolvable frontier is ignored [s]", 0.0, 1e6);
   o.blacklist_radius_m =
       s.GetDouble("blacklist_radius_m", d.blacklist_radius_m,
-                  "frontiers whose centroid is this close to a blacklisted one are ignored too [m]", 0.0, 100.0);
+                  "frontiers whose centroid is this close to a blacklisted one (and at most twice its size plus "
+                  "min_frontier_cells) are ignored too [m]",
+                  0.0, 100.0);
   o.frontier_match_m =
       s.GetDouble("frontier_match_m", d.frontier_match_m,
                   "the target frontier still exists while a frontier centroid is this close [m]", 0.0, 100.0);
+  o.home_retries = static_cast<int>(s.GetInt("home_retries", d.home_retries,
+                                             "at home with reachable frontiers given up only for a while (no path "
+                                             "then), forget them and explore again, at most this many times",
+                                             0, 100));
   return o;
 }
 

@@ -13,6 +13,13 @@ namespace mbot::planning {
 struct FrontierOptions {
   int min_cells = 5;             // regions with fewer frontier cells are ignored
   double search_radius_m = 1.0;  // radial search around a centroid for a reachable free cell
+  // What the map really knows. A cell is free for frontier detection only when its log-odds is at
+  // or below free_threshold, occupied when at or above occupied_threshold; a cell between the two
+  // (never seen, or seen only by a few grazing rays) counts as unknown, so a corridor glimpsed at a
+  // slant from its mouth keeps a frontier at the mouth. Log-odds change by miss_odds (1) per ray
+  // that crosses a cell: the default asks for about twenty.
+  int free_threshold = -20;
+  int occupied_threshold = 1;
 };
 
 struct Frontier {
@@ -22,9 +29,18 @@ struct Frontier {
   int size() const { return static_cast<int>(cells.size()); }
 };
 
-// Free cells (log-odds < 0) with an unknown 4-neighbour, grouped 8-connected by BFS; regions
-// smaller than options.min_cells are dropped. Sorted by size, largest first.
+// Confidently free cells (log-odds <= free_threshold) with a 4-neighbour that is neither confidently
+// free nor occupied, grouped 8-connected by BFS; regions smaller than options.min_cells are dropped.
+// Sorted by size, largest first.
 std::vector<Frontier> FindFrontiers(const mapping::OccupancyGrid& map, const FrontierOptions& options);
+
+// What the frontier detection sees in a map, as cell centres (world frame) for a picture: cells
+// seen too faintly to count as free or occupied (between the thresholds, not unknown), and the
+// frontier cells of the regions FindFrontiers keeps.
+struct FrontierLayers {
+  std::vector<motion::Pose2D> faint, frontier;
+};
+FrontierLayers ComputeFrontierLayers(const mapping::OccupancyGrid& map, const FrontierOptions& options);
 
 struct FrontierGoal {
   int frontier = -1;      // index into the frontier list

@@ -22,6 +22,11 @@ struct ObstacleDistanceOptions {
   // clearance a planner needs from walls covers the grid's error (a thin wall anywhere in its cell,
   // the robot anywhere in its own); unseen space only has to stay out of the footprint.
   double unknown_margin_m = 0.0;
+  // With unknown_is_obstacle: a cell counts as unknown unless its log-odds is at or below this
+  // (and it is not an obstacle). -1: every free cell is known (the botlab rule, < 0 is free);
+  // exploration asks for the frontiers' confidence, so faint cells seen by a few grazing rays (a
+  // thin wall's end, a corridor glimpsed at a slant) are not driven through as if they were free.
+  int free_threshold = -1;
 };
 
 class ObstacleDistanceGrid {

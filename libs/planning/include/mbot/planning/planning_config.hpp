@@ -19,7 +19,7 @@ AStarOptions ParseAStarOptions(config::Section& section, const AStarOptions& def
 // Keys unknown_is_obstacle, occupied_threshold.
 ObstacleDistanceOptions ParseObstacleDistanceOptions(config::Section& section,
                                                      const ObstacleDistanceOptions& defaults = {});
-// Keys min_frontier_cells, frontier_search_radius_m.
+// Keys min_frontier_cells, frontier_search_radius_m, frontier_free_threshold, frontier_occupied_threshold.
 FrontierOptions ParseFrontierOptions(config::Section& section, const FrontierOptions& defaults = {});
 // Everything above plus home_tolerance_m, target_reached_m, blacklist_s, blacklist_radius_m,
 // frontier_match_m.
