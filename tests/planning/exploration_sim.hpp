@@ -21,6 +21,7 @@ struct ScriptedRun {
   int paths = 0;
   double coverage = 0.0;  // share of true free cells reachable from home now known
   mapping::OccupancyGrid known;
+  std::vector<FrontierLeft> left;  // the explorer's account of the frontiers left at the end
 };
 
 // Marks what a 360° sensor of `range_m` sees from (x, y): free cells along each ray up to the first
@@ -109,7 +110,8 @@ inline ScriptedRun RunScripted(mapping::OccupancyGrid truth, const motion::Pose2
         next = 1;
         ++run.paths;
       }
-      if (u.state == ExplorationState::kCompleted || u.state == ExplorationState::kFailed) {
+      if (u.state == ExplorationState::kCompleted || u.state == ExplorationState::kIncomplete ||
+          u.state == ExplorationState::kFailed) {
         run.final_state = u.state;
         run.reason = u.reason;
         break;
@@ -150,6 +152,7 @@ inline ScriptedRun RunScripted(mapping::OccupancyGrid truth, const motion::Pose2
   for (int c : reachable) seen += known.cells()[c] != 0;
   run.coverage = reachable.empty() ? 0.0 : double(seen) / reachable.size();
   run.known = std::move(known);
+  run.left = explorer.left();
   if (run.final_state == ExplorationState::kInitializing) {
     run.final_state = explorer.state();
     run.reason = "stopped after " + std::to_string(run.updates) + " updates in state " + ToString(explorer.state());

@@ -41,6 +41,33 @@ TEST(ExplorationTest, ExploresEveryReachableRegionAndEndsAtHome) {
   EXPECT_GT(run.paths, 3);
 }
 
+// A pocket of space the sensor never sees into (unknown in the truth: rays stop at it) behind a
+// 0.15 m slot in room 3's wall: its frontier stays. The robot goes there, waits, gives it up,
+// explores the rest, goes home — and says the exploration is incomplete, with the frontier's count
+// and place, instead of "completed".
+TEST(ExplorationTest, FrontierLeftBehindEndsIncompleteWithCountAndPlace) {
+  OccupancyGrid truth = Arena();
+  for (int y = 1; y <= 10; ++y) {
+    for (int x = 70; x <= 78; ++x) truth.at(x, y) = 0;  // never seen
+  }
+  for (int y = 0; y <= 11; ++y) truth.at(69, y) = 100;
+  for (int x = 69; x <= 79; ++x) truth.at(x, 11) = 100;
+  for (int y = 5; y <= 7; ++y) truth.at(69, y) = -100;  // the slot
+  ExplorationOptions o;
+  o.frontier.min_cells = 1;
+  const Pose2D home{-0.5, -0.5, 0.0};
+  const testing::ScriptedRun run = testing::RunScripted(truth, home, o, 1.5);
+  EXPECT_EQ(run.final_state, ExplorationState::kIncomplete) << run.reason;
+  EXPECT_LE(std::hypot(run.final_pose.x - home.x, run.final_pose.y - home.y), 0.03);
+  EXPECT_GE(run.coverage, 0.99);  // everything else was explored first
+  ASSERT_EQ(run.left.size(), 1u) << run.reason;
+  EXPECT_NEAR(run.left[0].x, -1.0 + 69.5 * 0.05, 0.06);
+  EXPECT_NEAR(run.left[0].y, -1.0 + 6.5 * 0.05, 0.06);
+  EXPECT_TRUE(run.left[0].blacklisted);
+  EXPECT_NE(run.reason.find("incomplete: home reached"), std::string::npos) << run.reason;
+  EXPECT_NE(run.reason.find("1 frontier(s) left"), std::string::npos) << run.reason;
+}
+
 TEST(ExplorationTest, HomeCutOffEndsInFailedWithTheReason) {
   ExplorationOptions o;
   const Pose2D home{-0.5, -0.5, 0.0};

@@ -7,6 +7,7 @@
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/config.hpp"
+#include "mbot/drivers/map_io.hpp"
 #include "mbot/mission/mission.hpp"
 #include "mbot/mission/mission_config.hpp"
 #include "report.hpp"
@@ -65,8 +66,32 @@ class MissionStage : public Stage {
       << ",\n  \"odometry_restarts\": " << r.odometry_restarts << ",\n  \"rounds\": " << r.rounds;
     if (r.task == mission::TaskKind::kWarehouse)
       j << ",\n  \"stops\": " << r.stops << ",\n  \"stops_done\": " << r.stops_done;
+    if (r.task == mission::TaskKind::kExplore || o_.mission.explore_first) {
+      j << ",\n  \"frontiers_left\": [";
+      for (size_t i = 0; i < r.frontiers_left.size(); ++i) {
+        const planning::FrontierLeft& f = r.frontiers_left[i];
+        j << (i ? ",\n    " : "\n    ") << "{\"x\": " << f.x << ", \"y\": " << f.y << ", \"cells\": " << f.cells
+          << ", \"reachable\": " << (f.reachable ? "true" : "false")
+          << ", \"given_up\": " << (f.blacklisted ? "true" : "false") << "}";
+      }
+      j << (r.frontiers_left.empty() ? "]" : "\n  ]");
+    }
     j << "\n}\n";
     WriteFileAtomically(ctx.output_dir + "/mission.json", [&](std::ostream& out) { out << j.str(); });
+    if ((r.task == mission::TaskKind::kExplore || o_.mission.explore_first) && mission_->map()) {
+      // What the frontier detection saw in the last map: faint cells, frontier cells, the frontiers left.
+      const auto& frontier = o_.mission.exploration.frontier;
+      const planning::FrontierLayers layers = planning::ComputeFrontierLayers(*mission_->map(), frontier);
+      std::vector<motion::Pose2D> left;
+      for (const planning::FrontierLeft& f : r.frontiers_left) left.push_back({f.x, f.y, 0.0});
+      const std::string t = " (" + std::to_string(frontier.free_threshold) + " < log-odds < " +
+                            std::to_string(frontier.occupied_threshold) + ")";
+      drivers::WriteMapPngWithOverlays(mapping::CropToKnown(*mission_->map(), 0.3),
+                                       {{layers.faint, 120, 170, 230, true, "seen too faintly to count" + t},
+                                        {layers.frontier, 240, 140, 0, true, "frontier cells"},
+                                        {left, 214, 39, 40, true, "frontiers left at the end"}},
+                                       4, ctx.output_dir + "/frontiers.png");
+    }
   }
 
  private:

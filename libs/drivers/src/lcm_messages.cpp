@@ -433,7 +433,12 @@ std::map<int64_t, Entry> BuildTable() {
         }
         ev->kind = EventKind::kMissionStatus;
         ev->stamp_us = m.utime;
-        ev->payload = mission::MissionStatus{kExplorationStates[m.state], kExplorationStatuses[m.status]};
+        // Home with frontiers left travels as "completed exploration" with status "failed".
+        const bool incomplete = m.state == mbot_lcm_msgs::exploration_status_t::STATE_COMPLETED_EXPLORATION &&
+                                m.status == mbot_lcm_msgs::exploration_status_t::STATUS_FAILED;
+        ev->payload =
+            mission::MissionStatus{incomplete ? mission::MissionState::kIncomplete : kExplorationStates[m.state],
+                                   kExplorationStatuses[m.status]};
         return true;
       });
   add(mbot_lcm_msgs::slam_status_t::getHash(), "slam_status_t", kCurrent,
@@ -631,6 +636,10 @@ bool Encode(const Event& ev, std::vector<uint8_t>* out) {
       m.status = m.state == X::STATE_COMPLETED_EXPLORATION ? X::STATUS_COMPLETE
                  : m.state == X::STATE_FAILED_EXPLORATION  ? X::STATUS_FAILED
                                                            : X::STATUS_IN_PROGRESS;
+      if (st.state == mission::MissionState::kIncomplete) {  // home, frontiers left: completed, not successfully
+        m.state = X::STATE_COMPLETED_EXPLORATION;
+        m.status = X::STATUS_FAILED;
+      }
       EncodeMessage(m, out);
       return true;
     }

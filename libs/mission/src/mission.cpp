@@ -88,7 +88,8 @@ std::vector<MissionOutput> Mission::OnOdometry(int64_t t_us, const Pose2D& raw_o
     ++stale_stops_;
     SetState(status_.state, "SLAM pose stale: stopped");
     Hold();
-  } else if (status_.state == MissionState::kCompleted && exploring_first_) {
+  } else if ((status_.state == MissionState::kCompleted || status_.state == MissionState::kIncomplete) &&
+             exploring_first_) {
     exploring_first_ = false;  // explored and home: now the task, on the map just made
     task_ = MakeTask(o_, seed_);
     final_leg_ = false;

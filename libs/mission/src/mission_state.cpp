@@ -6,7 +6,7 @@ namespace {
 constexpr MissionState kAll[] = {MissionState::kInitializing, MissionState::kLocalizing,  MissionState::kWaiting,
                                  MissionState::kDriving,      MissionState::kExploring,   MissionState::kReturningHome,
                                  MissionState::kLifting,      MissionState::kSettingDown, MissionState::kArrived,
-                                 MissionState::kCompleted,    MissionState::kFailed};
+                                 MissionState::kCompleted,    MissionState::kIncomplete,  MissionState::kFailed};
 }
 
 const char* ToString(MissionState s) {
@@ -21,6 +21,7 @@ const char* ToString(MissionState s) {
     case MissionState::kSettingDown: return "setting_down";
     case MissionState::kArrived: return "arrived";
     case MissionState::kCompleted: return "completed";
+    case MissionState::kIncomplete: return "incomplete";
     case MissionState::kFailed: return "failed";
   }
   return "?";

@@ -49,16 +49,19 @@ class ExploreTask : public Task {
       m.Hold();
       return false;
     }
-    if (u.new_path || u.state == planning::ExplorationState::kCompleted) {
+    const bool done =
+        u.state == planning::ExplorationState::kCompleted || u.state == planning::ExplorationState::kIncomplete;
+    if (u.new_path || done) {
       // Home is a pose: the way back ends in the heading the robot started with.
       std::vector<Pose2D> path = u.path;
-      if (u.state == planning::ExplorationState::kCompleted) path = {explorer_.home()};
+      if (done) path = {explorer_.home()};
       if (u.state != planning::ExplorationState::kExploring && !path.empty())
         path.back().theta = explorer_.home().theta;
       m.SetPath(path);
     }
-    if (u.state == planning::ExplorationState::kCompleted) {
-      explored_ = true;  // at home: the controller settles the final pose, then the mission is complete
+    if (done) {
+      explored_ = true;  // at home: the controller settles the final pose, then the mission ends
+      end_ = u.reason;
       m.SetGoal(explorer_.home());
       m.SetState(MissionState::kReturningHome, "aligning at home");
     } else {
@@ -68,9 +71,14 @@ class ExploreTask : public Task {
   }
   void Arrived(Mission& m, const std::string& how) override {
     m.EndFinalLeg();
-    m.SetState(MissionState::kCompleted, "explored and home (" + how + ")");
+    if (explorer_.state() == planning::ExplorationState::kIncomplete) {
+      m.SetState(MissionState::kIncomplete, "home, exploration " + end_ + " (" + how + ")");
+    } else {
+      m.SetState(MissionState::kCompleted, "explored and home (" + how + ")");
+    }
   }
   void Stalled(Mission&) override { last_explore_us_ = -1; }  // replan as soon as the back-off ends
+  void AddToReport(MissionReport* r) const override { r->frontiers_left = explorer_.left(); }
 
  private:
   static MissionState ToMissionState(planning::ExplorationState s) {
@@ -79,6 +87,7 @@ class ExploreTask : public Task {
       case planning::ExplorationState::kExploring: return MissionState::kExploring;
       case planning::ExplorationState::kReturningHome: return MissionState::kReturningHome;
       case planning::ExplorationState::kCompleted: return MissionState::kCompleted;
+      case planning::ExplorationState::kIncomplete: return MissionState::kIncomplete;
       case planning::ExplorationState::kFailed: return MissionState::kFailed;
     }
     return MissionState::kFailed;
@@ -87,6 +96,7 @@ class ExploreTask : public Task {
   double period_s_;
   int64_t last_explore_us_ = -1;
   bool explored_ = false;  // the explorer is done; the controller finishes at home
+  std::string end_;        // how the explorer ended ("completed: …" or "incomplete: …")
 };
 
 // The Warehouse: stand still until global localization has settled, then drive to each stop in

@@ -25,16 +25,21 @@ const char* ToString(ExplorationState s) {
     case ExplorationState::kExploring: return "exploring";
     case ExplorationState::kReturningHome: return "returning home";
     case ExplorationState::kCompleted: return "completed";
+    case ExplorationState::kIncomplete: return "incomplete";
     case ExplorationState::kFailed: return "failed";
   }
   return "?";
 }
 
-Explorer::Explorer(const ExplorationOptions& options) : options_(options), planner_(options.astar) {}
+Explorer::Explorer(const ExplorationOptions& options)
+    : options_(options), planner_(options.astar), home_retries_left_(options.home_retries) {}
 
 bool Explorer::IsBlacklisted(const Frontier& f, double t_s) const {
   for (const Blacklisted& b : blacklist_) {
-    if (t_s < b.until_s && std::hypot(f.centroid_x - b.x, f.centroid_y - b.y) <= options_.blacklist_radius_m)
+    // Near a frontier given up, and not grown much since: the same one. A frontier that has grown
+    // (a small one at a gap became the mouth of a corridor) is new.
+    if (t_s < b.until_s && std::hypot(f.centroid_x - b.x, f.centroid_y - b.y) <= options_.blacklist_radius_m &&
+        f.size() <= 2 * b.cells + options_.frontier.min_cells)
       return true;
   }
   return false;
@@ -78,13 +83,14 @@ bool Explorer::SelectFrontier(const mapping::OccupancyGrid& map, const motion::P
   const std::vector<FrontierGoal> goals =
       RankFrontierGoals(frontiers_, pose, map, planner_, r, options_.frontier, &unreachable);
   for (int i : unreachable) {
-    blacklist_.push_back({frontiers_[i].centroid_x, frontiers_[i].centroid_y, t_s + options_.blacklist_s});
+    blacklist_.push_back(
+        {frontiers_[i].centroid_x, frontiers_[i].centroid_y, t_s + options_.blacklist_s, frontiers_[i].size()});
   }
   for (const FrontierGoal& g : goals) {
     const Frontier& f = frontiers_[g.frontier];
     const PlanResult plan = planner_.PlanSteppingOut(pose, g.target);
     if (plan.status != PlanStatus::kFound) {
-      blacklist_.push_back({f.centroid_x, f.centroid_y, t_s + options_.blacklist_s});
+      blacklist_.push_back({f.centroid_x, f.centroid_y, t_s + options_.blacklist_s, f.size()});
       continue;
     }
     path_ = plan.path;
@@ -102,9 +108,23 @@ bool Explorer::SelectFrontier(const mapping::OccupancyGrid& map, const motion::P
   return false;
 }
 
+std::vector<FrontierLeft> Explorer::FrontiersLeft(const mapping::OccupancyGrid& map, const motion::Pose2D& pose,
+                                                  double t_s) {
+  const std::vector<Frontier> all = FindFrontiers(map, options_.frontier);
+  std::vector<int> unreachable;
+  RankFrontierGoals(all, pose, map, planner_, options_.astar.robot_radius_m, options_.frontier, &unreachable);
+  std::vector<FrontierLeft> left;
+  for (int i = 0; i < static_cast<int>(all.size()); ++i) {
+    const bool reachable = std::find(unreachable.begin(), unreachable.end(), i) == unreachable.end();
+    left.push_back({all[i].centroid_x, all[i].centroid_y, all[i].size(), reachable, IsBlacklisted(all[i], t_s)});
+  }
+  return left;
+}
+
 ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const motion::Pose2D& pose, double t_s) {
   ExplorationUpdate u;
-  if (state_ == ExplorationState::kCompleted || state_ == ExplorationState::kFailed) {
+  if (state_ == ExplorationState::kCompleted || state_ == ExplorationState::kIncomplete ||
+      state_ == ExplorationState::kFailed) {
     u.state = state_;
     u.reason = failure_reason_;
     return u;
@@ -180,7 +200,8 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
         // Standing at the target and the frontier is still there: nothing more can be seen from
         // here (unknown space the sensor cannot resolve, a gap too narrow to pass). Waiting longer
         // will not change that, so it is ignored for good, unlike a frontier that was only unreachable.
-        blacklist_.push_back({target_frontier_->x, target_frontier_->y, std::numeric_limits<double>::infinity()});
+        blacklist_.push_back(
+            {target_frontier_->x, target_frontier_->y, std::numeric_limits<double>::infinity(), target_size_});
         need = true;
         why = "frontier unresolved at its target, blacklisted";
       }
@@ -207,17 +228,70 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
       }
     }
   } else if (state_ == ExplorationState::kReturningHome) {
-    if (std::hypot(pose.x - home_.x, pose.y - home_.y) <= options_.home_tolerance_m) {
-      state_ = ExplorationState::kCompleted;
+    const double off = std::hypot(pose.x - home_.x, pose.y - home_.y);
+    // What the robot saw on the way home (or a frontier whose blacklisting ran out) may have opened
+    // a frontier it can reach: it goes back to exploring rather than stopping early.
+    frontiers_ = FindFrontiers(map, options_.frontier);
+    frontiers_.erase(
+        std::remove_if(frontiers_.begin(), frontiers_.end(), [&](const Frontier& f) { return IsBlacklisted(f, t_s); }),
+        frontiers_.end());
+    const std::vector<motion::Pose2D> way_home = path_;
+    if (off > options_.home_tolerance_m && !frontiers_.empty() && SelectFrontier(map, pose, t_s, &u)) {
+      state_ = ExplorationState::kExploring;
+      u.reason = "a frontier is reachable again; " + u.reason;
+    } else if (off <= options_.home_tolerance_m) {
       path_.clear();
       u.new_path = true;
-      u.reason = Format("completed: home reached within %.3f m", std::hypot(pose.x - home_.x, pose.y - home_.y), 0.0);
-    } else if (path_.empty()) {
-      plan_home("");
-    } else if (!PathIsSafe(pose)) {
-      plan_home("(path no longer safe, replanned)");
-    } else if (std::hypot(pose.x - path_.back().x, pose.y - path_.back().y) <= options_.target_reached_m) {
-      plan_home("(end of path reached outside the home tolerance)");
+      left_ = FrontiersLeft(map, pose, t_s);
+      // Frontiers given up only for a while (no path to them then) that can be reached now: forget
+      // them and explore again, rather than end incomplete.
+      const bool retry = home_retries_left_ > 0 &&
+                         std::any_of(left_.begin(), left_.end(), [](const FrontierLeft& f) { return f.reachable; });
+      if (retry) {
+        --home_retries_left_;
+        blacklist_.erase(std::remove_if(blacklist_.begin(), blacklist_.end(),
+                                        [](const Blacklisted& b) { return std::isfinite(b.until_s); }),
+                         blacklist_.end());
+        frontiers_ = FindFrontiers(map, options_.frontier);
+        frontiers_.erase(std::remove_if(frontiers_.begin(), frontiers_.end(),
+                                        [&](const Frontier& f) { return IsBlacklisted(f, t_s); }),
+                         frontiers_.end());
+        if (SelectFrontier(map, pose, t_s, &u)) {
+          state_ = ExplorationState::kExploring;
+          left_.clear();
+          u.reason = "home, but a frontier given up for a while can be reached now; " + u.reason;
+          u.state = state_;
+          return u;
+        }
+        path_.clear();
+      }
+      if (left_.empty()) {
+        state_ = ExplorationState::kCompleted;
+        u.reason = Format("completed: home reached within %.3f m, no frontier left on the map", off, 0.0);
+      } else {
+        state_ = ExplorationState::kIncomplete;
+        int cells = 0, reachable = 0;
+        std::string where;
+        for (const FrontierLeft& f : left_) {
+          cells += f.cells;
+          reachable += f.reachable;
+          if (where.size() < 200) where += Format(" (%.2f, %.2f)", f.x, f.y);
+        }
+        u.reason = Format("incomplete: home reached within %.3f m; %.0f frontier(s) left", off,
+                          static_cast<double>(left_.size())) +
+                   Format(" (%.0f cells; %.0f with a reachable cell, given up as unresolved or unreachable) at",
+                          static_cast<double>(cells), static_cast<double>(reachable)) +
+                   where;
+      }
+    } else {
+      path_ = way_home;
+      if (path_.empty()) {
+        plan_home("");
+      } else if (!PathIsSafe(pose)) {
+        plan_home("(path no longer safe, replanned)");
+      } else if (std::hypot(pose.x - path_.back().x, pose.y - path_.back().y) <= options_.target_reached_m) {
+        plan_home("(end of path reached outside the home tolerance)");
+      }
     }
   }
   u.state = state_;

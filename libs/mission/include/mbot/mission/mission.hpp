@@ -68,9 +68,10 @@ struct MissionReport {
   MissionStatus status;
   long long commands = 0, paths = 0, stale_pose_stops = 0;
   int corrections = 0, stall_recoveries = 0;
-  int odometry_restarts = 0;
-  int rounds = 1;  // rounds of the task run (repeat + 1 when all completed)  // the robot's odometry started again from
-                   // zero (a firmware restart)
+  int odometry_restarts = 0;  // the robot's odometry started again from zero (a firmware restart)
+  int rounds = 1;             // rounds of the task run (repeat + 1 when all completed)
+  // explore: the frontiers left on the map at home (none when completed).
+  std::vector<planning::FrontierLeft> frontiers_left;
   // warehouse: stops in all, and done by the mission's own estimate.
   int stops = 0, stops_done = 0;
 };

@@ -18,14 +18,17 @@ enum class MissionState {
   kSettingDown,    // warehouse: standing at a drop-off
   kArrived,        // follow: at the end of a path, waiting for the next
   kCompleted,      // the task is done
+  kIncomplete,     // exploration: home, but frontiers were left (the detail counts and places them)
   kFailed,         // the task cannot go on (the detail says why)
 };
 
 // snake_case names: "initializing", "returning_home", "setting_down" …
 const char* ToString(MissionState state);
 std::optional<MissionState> MissionStateFromString(const std::string& name);
-// Completed or failed: the mission commands nothing more.
-inline bool IsFinal(MissionState s) { return s == MissionState::kCompleted || s == MissionState::kFailed; }
+// Completed, incomplete or failed: the mission commands nothing more.
+inline bool IsFinal(MissionState s) {
+  return s == MissionState::kCompleted || s == MissionState::kIncomplete || s == MissionState::kFailed;
+}
 
 struct MissionStatus {
   MissionState state = MissionState::kInitializing;

@@ -1,6 +1,7 @@
-// The exploration state machine: initializing → exploring → returning home → completed, or failed
-// with a reason. It consumes map and pose updates and produces paths; it never drives anything,
-// so it runs the same on a log, in the simulator and on a robot.
+// The exploration state machine: initializing → exploring → returning home → completed (no
+// frontier left on the final map), incomplete (home, but frontiers were left: unreachable or
+// unresolved, counted and placed), or failed with a reason. It consumes map and pose updates and produces paths; it
+// never drives anything, so it runs the same on a log, in the simulator and on a robot.
 #pragma once
 
 #include <optional>
@@ -17,8 +18,9 @@ namespace mbot::planning {
 
 struct ExplorationOptions {
   AStarOptions astar;
-  // Exploration keeps to mapped space: unknown cells count as obstacles for distances and paths.
-  ObstacleDistanceOptions distance{/*unknown_is_obstacle=*/true};
+  // Exploration keeps to mapped space: unknown cells, and cells seen too faintly to count as free for
+  // the frontiers, are obstacles for distances and paths.
+  ObstacleDistanceOptions distance{/*unknown_is_obstacle=*/true, 0, 0.0, FrontierOptions{}.free_threshold};
   FrontierOptions frontier;
   double home_tolerance_m = 0.03;      // completed when the robot is this close to home
   std::optional<motion::Pose2D> home;  // where to return; default: the pose exploration starts at
@@ -30,10 +32,21 @@ struct ExplorationOptions {
                                      // resolve_wait_s after its target was reached is ignored for good)
   double blacklist_radius_m = 0.30;  // frontiers whose centroid lies this close to a blacklisted one
   double frontier_match_m = 0.50;    // the target frontier still exists if a frontier centroid is this close
+  // At home with frontiers left that can be reached and were given up only for a while (no path
+  // then), the explorer forgets those and explores again, at most this many times.
+  int home_retries = 2;
 };
 
-enum class ExplorationState { kInitializing, kExploring, kReturningHome, kCompleted, kFailed };
+enum class ExplorationState { kInitializing, kExploring, kReturningHome, kCompleted, kIncomplete, kFailed };
 const char* ToString(ExplorationState state);
+
+// A frontier still on the map when exploration ended.
+struct FrontierLeft {
+  double x = 0, y = 0;       // its centroid [m]
+  int cells = 0;             // its size
+  bool reachable = false;    // a cell near it can be reached at the planning clearance
+  bool blacklisted = false;  // it was given up: unresolved at its target, or no path to it
+};
 
 struct ExplorationUpdate {
   ExplorationState state = ExplorationState::kInitializing;
@@ -54,16 +67,21 @@ class Explorer {
   const motion::Pose2D& home() const { return home_; }
   const std::vector<motion::Pose2D>& path() const { return path_; }
   const std::vector<Frontier>& frontiers() const { return frontiers_; }
+  // Completed or incomplete: the frontiers left on the map when the robot reached home (none when
+  // completed).
+  const std::vector<FrontierLeft>& left() const { return left_; }
   int replans() const { return replans_; }
 
  private:
   struct Blacklisted {
     double x, y, until_s;
+    int cells;  // the frontier's size when it was given up
   };
   bool IsBlacklisted(const Frontier& f, double t_s) const;
   bool PathIsSafe(const motion::Pose2D& pose) const;
   bool SelectFrontier(const mapping::OccupancyGrid& map, const motion::Pose2D& pose, double t_s, ExplorationUpdate* u);
   void Fail(const std::string& reason, ExplorationUpdate* u);
+  std::vector<FrontierLeft> FrontiersLeft(const mapping::OccupancyGrid& map, const motion::Pose2D& pose, double t_s);
 
   ExplorationOptions options_;
   AStarPlanner planner_;
@@ -75,8 +93,10 @@ class Explorer {
   double reached_at_s_ = -1;                       // when the robot reached the target of the frontier being explored
   std::vector<Blacklisted> blacklist_;
   std::vector<Frontier> frontiers_;
+  std::vector<FrontierLeft> left_;
   std::string failure_reason_;
   int replans_ = 0;
+  int home_retries_left_ = 0;
 };
 
 }  // namespace mbot::planning
