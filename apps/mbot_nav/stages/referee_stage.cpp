@@ -40,6 +40,7 @@ std::string ScoreJson(const sim::Score& s, const RunContext& ctx, const std::str
     << ",\n  \"arena\": " << JsonString(arena) << ",\n  \"seed\": " << ctx.seed
     << ",\n  \"state\": " << JsonString(mission::ToString(s.state)) << ",\n  \"detail\": " << JsonString(s.detail)
     << ",\n  \"completed\": " << (s.completed ? "true" : "false")
+    << ",\n  \"incomplete\": " << (s.incomplete ? "true" : "false")
     << ",\n  \"timed_out\": " << (s.timed_out ? "true" : "false")
     << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"time_s\": " << Num(s.time_s)
     << ",\n  \"sim_seconds\": " << Num(s.sim_s) << ",\n  \"wall_seconds\": " << Num(wall_s)
@@ -48,9 +49,10 @@ std::string ScoreJson(const sim::Score& s, const RunContext& ctx, const std::str
   if (s.final_error) j << ",\n  \"final_error\": " << ErrorJson(*s.final_error);
   if (s.slam_final_error) j << ",\n  \"slam_final_error\": " << ErrorJson(*s.slam_final_error);
   if (s.map) {
-    j << ",\n  \"map\": {\"coverage\": " << Num(s.map->coverage) << ", \"wall_precision\": " << Num(s.map->precision)
-      << ", \"reachable_cells\": " << s.map->reachable_cells << ", \"occupied_cells\": " << s.map->occupied_cells
-      << "}";
+    j << ",\n  \"map\": {\"coverage\": " << Num(s.map->coverage)
+      << ", \"coverage_one_cell\": " << Num(s.map->coverage_one_cell)
+      << ", \"wall_precision\": " << Num(s.map->precision) << ", \"reachable_cells\": " << s.map->reachable_cells
+      << ", \"occupied_cells\": " << s.map->occupied_cells << "}";
   }
   if (s.event == sim::CompetitionEvent::kWarehouse) {
     j << ",\n  \"localized_at_s\": " << (s.localized_at_s ? Num(*s.localized_at_s) : "null")
@@ -142,6 +144,8 @@ class RefereeStage : public Stage {
                                                 {driven, 31, 119, 180, false, "SLAM path"}};
       if (!path_.empty()) overlays.push_back({path_, 214, 39, 40, false, "last planned path"});
       if (!stops.empty()) overlays.push_back({stops, 44, 160, 44, true, "targets and drop-offs"});
+      if (s.map && !s.map->unmapped.empty())
+        overlays.push_back({s.map->unmapped, 240, 140, 0, true, "reachable space not mapped"});
       drivers::WriteMapPngWithOverlays(mapping::CropToKnown(*map, 0.3), overlays, 4, dir + "/final_map.png");
     }
     WriteFileAtomically(dir + "/score.json",

@@ -64,21 +64,37 @@ MapQuality Quality(const World& world, const mapping::OccupancyGrid& m, const Po
   const mapping::OccupancyGrid& truth = world.truth();
   const std::vector<uint8_t> reach = ReachableFreeMask(world, start);
   const Pose2D inv = start.Inverse();
-  int mapped = 0;
+  // The free space that must be mapped keeps 1.5 map cells from the walls, the tolerance the wall
+  // check below gives: a wall mapped up to 1.5 cells off counts as right, so the space it may cover
+  // is not counted as missed. (A wall's cell reaches up to a cell beyond its surface, and range
+  // noise spills hits into the next cell where the surface lies near a cell boundary: with 1 cm of
+  // lidar noise those cells are saturated walls, which one cell of tolerance alone scored as missed.)
+  // The share at one cell is kept beside it.
+  int mapped = 0, counted_strict = 0, mapped_strict = 0;
   for (int cy = 0; cy < truth.height(); ++cy) {
     for (int cx = 0; cx < truth.width(); ++cx) {
       if (!reach[static_cast<size_t>(cy) * truth.width() + cx]) continue;
       double x, y;
       truth.CellToWorld(cx, cy, &x, &y);
-      if (world.ClearanceAt(x, y) < m.resolution()) continue;  // "walls within one cell"
-      ++q.reachable_cells;
+      const double clearance = world.ClearanceAt(x, y);
+      if (clearance < m.resolution()) continue;
       const Pose2D p = inv.Compose(Pose2D{x, y, 0});
       int mx, my;
       m.WorldToCell(p.x, p.y, &mx, &my);
-      if (m.IsInside(mx, my) && m.at(mx, my) < 0) ++mapped;
+      const bool free = m.IsInside(mx, my) && m.at(mx, my) < 0;
+      ++counted_strict;
+      mapped_strict += free;
+      if (clearance < 1.5 * m.resolution()) continue;
+      ++q.reachable_cells;
+      if (free) {
+        ++mapped;
+      } else {
+        q.unmapped.push_back(p);
+      }
     }
   }
   q.coverage = q.reachable_cells ? double(mapped) / q.reachable_cells : 0.0;
+  q.coverage_one_cell = counted_strict ? double(mapped_strict) / counted_strict : 0.0;
   int near_wall = 0;
   for (int cy = 0; cy < m.height(); ++cy) {
     for (int cx = 0; cx < m.width(); ++cx) {
@@ -168,6 +184,7 @@ Score Referee::Judge() const {
   s.collisions = collisions_;
   s.sim_s = t0_us_ >= 0 ? (last_us_ - t0_us_) * 1e-6 : 0.0;
   s.completed = state_ == mission::MissionState::kCompleted;
+  s.incomplete = state_ == mission::MissionState::kIncomplete;
   s.time_s = end_us_ >= 0 ? (end_us_ - t0_us_) * 1e-6 : s.sim_s;
   if (truth_.empty()) return s;
   s.scored = true;
@@ -186,8 +203,10 @@ Score Referee::Judge() const {
     // Final pose against the start (the robot had to come back).
     const PoseError e = ErrorBetween(s.final_pose, s.start);
     s.final_error = e;
-    s.items.push_back({"final pose", Errors(e) + " from the start" + (s.completed ? "" : " (not completed)"),
-                       s.completed ? PosePoints(e) : 0});
+    // An exploration that came home with frontiers left still scores where it stopped.
+    const bool home = s.completed || s.incomplete;
+    s.items.push_back(
+        {"final pose", Errors(e) + " from the start" + (home ? "" : " (not completed)"), home ? PosePoints(e) : 0});
     const MapQuality mq = map_ ? Quality(world_, *map_, s.start) : MapQuality{};
     s.map = mq;
     s.items.push_back(
@@ -198,8 +217,11 @@ Score Referee::Judge() const {
     if (o_.event == CompetitionEvent::kSpeedRun) {
       s.items.push_back({"lap time", Significant(s.time_s, 4) + " s", s.completed ? LapPoints(s.time_s) : 0});
     } else {
-      s.items.push_back(
-          {"autonomy", s.completed ? "explored and home, no help" : "not completed", s.completed ? 100 : 0});
+      s.items.push_back({"autonomy",
+                         s.completed    ? "explored and home, no help"
+                         : s.incomplete ? "home, but the robot reported its exploration incomplete"
+                                        : "not completed",
+                         s.completed ? 100 : 0});
     }
   } else {
     if (localized_us_ >= 0) s.localized_at_s = (localized_us_ - t0_us_) * 1e-6;

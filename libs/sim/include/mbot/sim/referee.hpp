@@ -43,9 +43,11 @@ struct PoseError {
 };
 
 struct MapQuality {
-  double coverage = 0;   // share of the reachable free space (≥ one SLAM cell from walls) mapped free
-  double precision = 0;  // share of the mapped walls within 1.5 SLAM cells of a true wall
+  double coverage = 0;           // share of the reachable free space (≥ 1.5 SLAM cells from walls) mapped free
+  double coverage_one_cell = 0;  // the same share with one cell kept from the walls
+  double precision = 0;          // share of the mapped walls within 1.5 SLAM cells of a true wall
   int reachable_cells = 0, occupied_cells = 0;
+  std::vector<motion::Pose2D> unmapped;  // centres of the reachable true cells not mapped free (map frame)
 };
 
 struct StopResult {
@@ -58,8 +60,9 @@ struct Score {
   CompetitionEvent event = CompetitionEvent::kSpeedRun;
   mission::MissionState state = mission::MissionState::kInitializing;
   std::string detail;
-  bool scored = false;     // false without ground truth (nothing to judge)
-  bool completed = false;  // the mission said completed
+  bool scored = false;      // false without ground truth (nothing to judge)
+  bool completed = false;   // the mission said completed
+  bool incomplete = false;  // the mission said incomplete (exploration: home, frontiers left)
   bool timed_out = false;
   double time_s = 0;  // to the mission's end, or the whole run
   double sim_s = 0;   // simulated time seen
