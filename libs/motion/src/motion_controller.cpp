@@ -97,6 +97,9 @@ VelocityCommand MotionController::Target(const Pose2D& pose) {
   return {};
 }
 
+// On a final line, the leg ends this close before the goal: the ramp to zero covers the rest.
+constexpr double kFinalLineStopM = 0.004;
+
 bool MotionController::PurePursuit(const Pose2D& pose, VelocityCommand* cmd) {
   if (path_.empty()) {  // the polyline starts where the robot is when it starts following
     path_.push_back(pose);
@@ -123,17 +126,34 @@ bool MotionController::PurePursuit(const Pose2D& pose, VelocityCommand* cmd) {
     }
   }
   target_ = segment_;  // segment k ends at waypoint k
-  const double s_goal = std::min(projection_m_ + lookahead, total);
-  if (projection_m_ + lookahead >= total && Dist(pose, waypoints_.back()) < options_.final_tolerance_m) {
-    return false;
+  const Pose2D& end = waypoints_.back();
+  // The last leg is finished along its own line: the look-ahead point goes on past the goal along
+  // the leg instead of stopping on it (so the heading does not swing in the last centimetres), and
+  // the robot brakes at max_accel to stop on the goal, in the time a constant deceleration takes
+  // rather than the long tail of a speed proportional to the distance. (A circuit's last leg runs
+  // in the start's heading, so it also arrives facing the right way.)
+  const Pose2D& before = path_[path_.size() - 2];
+  const bool final_line = segment_ + 2 == path_.size() && Dist(before, end) > lookahead;
+  const double phi = std::atan2(end.y - before.y, end.x - before.x);
+  const double ahead = (end.x - pose.x) * std::cos(phi) + (end.y - pose.y) * std::sin(phi);
+  const double aside = -(end.x - pose.x) * std::sin(phi) + (end.y - pose.y) * std::cos(phi);
+  // Level with the goal, or so near that it lies more to the side than ahead: Settled judges how well.
+  if (final_line && ahead <= std::max(kFinalLineStopM, std::abs(aside))) return false;
+  if (!final_line && projection_m_ + lookahead >= total && Dist(pose, end) < options_.final_tolerance_m) return false;
+  const double s_goal = final_line ? projection_m_ + lookahead : std::min(projection_m_ + lookahead, total);
+
+  Pose2D goal;
+  if (s_goal > total) {
+    goal = end;
+    goal.x += (s_goal - total) * std::cos(phi);
+    goal.y += (s_goal - total) * std::sin(phi);
+  } else {
+    size_t j = segment_;
+    while (j + 2 < path_.size() && arc_[j + 1] < s_goal) ++j;
+    const double len = arc_[j + 1] - arc_[j];
+    const double u = len > 0.0 ? std::clamp((s_goal - arc_[j]) / len, 0.0, 1.0) : 1.0;
+    goal = Interpolate(path_[j], path_[j + 1], u);  // its heading is not used
   }
-
-  size_t j = segment_;
-  while (j + 2 < path_.size() && arc_[j + 1] < s_goal) ++j;
-  const double len = arc_[j + 1] - arc_[j];
-  const double u = len > 0.0 ? std::clamp((s_goal - arc_[j]) / len, 0.0, 1.0) : 1.0;
-  const Pose2D goal = Interpolate(path_[j], path_[j + 1], u);  // its heading is not used
-
   const Pose2D local = pose.Inverse().Compose(goal);
   const double e = std::atan2(local.y, local.x);
   if (std::abs(e) > options_.turn_in_place_rad) {
@@ -145,7 +165,8 @@ bool MotionController::PurePursuit(const Pose2D& pose, VelocityCommand* cmd) {
   // lookahead_m so the law stays right when the point is clipped at the end or the robot is off
   // the path; near the end v ∝ chord, which keeps ω = v·κ bounded.
   const double kappa = chord2 > 0.0 ? 2.0 * local.y / chord2 : 0.0;
-  double v = Speed(std::sqrt(chord2) + total - s_goal);
+  double v = final_line ? std::min(options_.max_speed_m_s, std::sqrt(2.0 * options_.max_accel_m_s2 * ahead))
+                        : Speed(std::sqrt(chord2) + total - s_goal);
   if (std::abs(kappa) * v > options_.max_turn_rate_rad_s) v = options_.max_turn_rate_rad_s / std::abs(kappa);
   *cmd = {v, v * kappa};
   return true;
