@@ -3,7 +3,8 @@
 // rooms, dead ends). Every maze: completed, >= 99 % of the reachable free space mapped, home within
 // 0.05 m, no collision.
 //   MazeSample (label simulation, the default run): three mazes that once failed — a long corridor
-//     seen only at a slant from its mouth (7, 9) and the largest loop (21).
+//     seen only at a slant from its mouth (7), a frontier banded along such a corridor (9), a free
+//     wall end seen faintly and touched (6).
 //   MazeSweep (label mazes: ctest -C mazes -L mazes): mazes MBOT_MAZE_FIRST .. MBOT_MAZE_LAST
 //     (default 1 .. 100), with a table of the results (on stdout, and in build/tests/out/maze_sweep.md
 //     or MBOT_MAZE_SWEEP_MD) — the table in BENCHMARKS.md.
@@ -52,7 +53,7 @@ TEST_P(MazeSample, ExploredMappedAndHomeWithoutCollision) {
   const MazeRun r = ExploreGeneratedMaze(GetParam());
   ExpectExploredMappedAndHome(r.json);
 }
-INSTANTIATE_TEST_SUITE_P(GeneratedMazes, MazeSample, ::testing::Values(7, 9, 21));
+INSTANTIATE_TEST_SUITE_P(GeneratedMazes, MazeSample, ::testing::Values(6, 7, 9));
 
 double Median(std::vector<double> v) {
   if (v.empty()) return NAN;

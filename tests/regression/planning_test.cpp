@@ -40,6 +40,19 @@ struct ArenaCase {
 
 class ExplorationRegressionTest : public ::testing::TestWithParam<ArenaCase> {};
 
+// True when a cell unknown in the truth lies within radius_m of (x, y).
+bool NearUnknownTruth(const mapping::OccupancyGrid& truth, double x, double y, double radius_m) {
+  int cx, cy;
+  truth.WorldToCell(x, y, &cx, &cy);
+  const int r = static_cast<int>(std::ceil(radius_m / truth.resolution()));
+  for (int dy = -r; dy <= r; ++dy) {
+    for (int dx = -r; dx <= r; ++dx) {
+      if (truth.IsInside(cx + dx, cy + dy) && truth.at(cx + dx, cy + dy) == 0) return true;
+    }
+  }
+  return false;
+}
+
 // The explorer maps every reachable region of a real botlab arena and returns home, never
 // driving within the robot radius of a wall.
 TEST_P(ExplorationRegressionTest, ExploresTheArenaAndReturnsHome) {
@@ -52,7 +65,18 @@ TEST_P(ExplorationRegressionTest, ExploresTheArenaAndReturnsHome) {
         << ", driven " << run.driven_m << " m, " << run.paths << " paths, " << run.updates << " updates, min clearance "
         << run.min_true_clearance_m;
   std::cout << facts.str() << "\n";
-  EXPECT_EQ(run.final_state, ExplorationState::kCompleted) << facts.str();
+  // These maps were made from real logs and hold unknown space of their own (gaps in the walls,
+  // unseen corners) that the scripted sensor cannot see into: frontiers there stay, and the honest
+  // end is "incomplete" with each of them placed beside such space. Everything reachable is mapped.
+  if (run.final_state == ExplorationState::kIncomplete) {
+    ASSERT_FALSE(run.left.empty()) << facts.str();
+    for (const FrontierLeft& f : run.left) {
+      EXPECT_TRUE(NearUnknownTruth(truth, f.x, f.y, 0.5))
+          << "a frontier left at (" << f.x << ", " << f.y << ") has no unseeable space near it; " << facts.str();
+    }
+  } else {
+    EXPECT_EQ(run.final_state, ExplorationState::kCompleted) << facts.str();
+  }
   EXPECT_GE(run.coverage, 0.99) << facts.str();
   EXPECT_LE(std::hypot(run.final_pose.x - c.home.x, run.final_pose.y - c.home.y), 0.03) << facts.str();
   EXPECT_GT(run.min_true_clearance_m, o.astar.robot_radius_m) << facts.str();
