@@ -64,6 +64,8 @@ TEST(ExplorationTest, FrontierLeftBehindEndsIncompleteWithCountAndPlace) {
   EXPECT_NEAR(run.left[0].x, -1.0 + 69.5 * 0.05, 0.06);
   EXPECT_NEAR(run.left[0].y, -1.0 + 6.5 * 0.05, 0.06);
   EXPECT_TRUE(run.left[0].blacklisted);
+  EXPECT_TRUE(run.left[0].unresolved);  // the robot stood at it and it stayed
+  EXPECT_TRUE(run.left[0].reachable);
   EXPECT_NE(run.reason.find("incomplete: home reached"), std::string::npos) << run.reason;
   EXPECT_NE(run.reason.find("1 frontier(s) left"), std::string::npos) << run.reason;
 }

@@ -71,8 +71,11 @@ class MissionStage : public Stage {
       for (size_t i = 0; i < r.frontiers_left.size(); ++i) {
         const planning::FrontierLeft& f = r.frontiers_left[i];
         j << (i ? ",\n    " : "\n    ") << "{\"x\": " << f.x << ", \"y\": " << f.y << ", \"cells\": " << f.cells
-          << ", \"reachable\": " << (f.reachable ? "true" : "false")
-          << ", \"given_up\": " << (f.blacklisted ? "true" : "false") << "}";
+          << ", \"reachable\": " << (f.reachable ? "true" : "false") << ", \"given_up\": "
+          << (f.unresolved    ? "\"for good\""
+              : f.blacklisted ? "\"for a while\""
+                              : "false")
+          << "}";
       }
       j << (r.frontiers_left.empty() ? "]" : "\n  ]");
     }

@@ -34,15 +34,20 @@ const char* ToString(ExplorationState s) {
 Explorer::Explorer(const ExplorationOptions& options)
     : options_(options), planner_(options.astar), home_retries_left_(options.home_retries) {}
 
-bool Explorer::IsBlacklisted(const Frontier& f, double t_s) const {
+bool Explorer::IsBlacklisted(const Frontier& f, double t_s, bool* for_good) const {
+  bool found = false;
+  if (for_good) *for_good = false;
   for (const Blacklisted& b : blacklist_) {
     // Near a frontier given up, and not grown much since: the same one. A frontier that has grown
     // (a small one at a gap became the mouth of a corridor) is new.
     if (t_s < b.until_s && std::hypot(f.centroid_x - b.x, f.centroid_y - b.y) <= options_.blacklist_radius_m &&
-        f.size() <= 2 * b.cells + options_.frontier.min_cells)
-      return true;
+        f.size() <= 2 * b.cells + options_.frontier.min_cells) {
+      found = true;
+      if (!for_good) return true;
+      if (std::isinf(b.until_s)) *for_good = true;
+    }
   }
-  return false;
+  return found;
 }
 
 bool Explorer::PathIsSafe(const motion::Pose2D& pose) const {
@@ -116,7 +121,9 @@ std::vector<FrontierLeft> Explorer::FrontiersLeft(const mapping::OccupancyGrid& 
   std::vector<FrontierLeft> left;
   for (int i = 0; i < static_cast<int>(all.size()); ++i) {
     const bool reachable = std::find(unreachable.begin(), unreachable.end(), i) == unreachable.end();
-    left.push_back({all[i].centroid_x, all[i].centroid_y, all[i].size(), reachable, IsBlacklisted(all[i], t_s)});
+    bool for_good = false;
+    const bool blacklisted = IsBlacklisted(all[i], t_s, &for_good);
+    left.push_back({all[i].centroid_x, all[i].centroid_y, all[i].size(), reachable, blacklisted, for_good});
   }
   return left;
 }
@@ -245,8 +252,9 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
       left_ = FrontiersLeft(map, pose, t_s);
       // Frontiers given up only for a while (no path to them then) that can be reached now: forget
       // them and explore again, rather than end incomplete.
-      const bool retry = home_retries_left_ > 0 &&
-                         std::any_of(left_.begin(), left_.end(), [](const FrontierLeft& f) { return f.reachable; });
+      const bool retry = home_retries_left_ > 0 && std::any_of(left_.begin(), left_.end(), [](const FrontierLeft& f) {
+                           return f.reachable && !f.unresolved;
+                         });
       if (retry) {
         --home_retries_left_;
         blacklist_.erase(std::remove_if(blacklist_.begin(), blacklist_.end(),
@@ -270,18 +278,18 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
         u.reason = Format("completed: home reached within %.3f m, no frontier left on the map", off, 0.0);
       } else {
         state_ = ExplorationState::kIncomplete;
-        int cells = 0, reachable = 0;
+        int cells = 0, unresolved = 0;
         std::string where;
         for (const FrontierLeft& f : left_) {
           cells += f.cells;
-          reachable += f.reachable;
+          unresolved += f.unresolved;
           if (where.size() < 200) where += Format(" (%.2f, %.2f)", f.x, f.y);
         }
         u.reason = Format("incomplete: home reached within %.3f m; %.0f frontier(s) left", off,
                           static_cast<double>(left_.size())) +
-                   Format(" (%.0f cells; %.0f with a reachable cell, given up as unresolved or unreachable) at",
-                          static_cast<double>(cells), static_cast<double>(reachable)) +
-                   where;
+                   Format(" (%.0f cells; %.0f unresolved at their target", static_cast<double>(cells),
+                          static_cast<double>(unresolved)) +
+                   Format(", %.0f without a path) at", static_cast<double>(left_.size() - unresolved), 0.0) + where;
       }
     } else {
       path_ = way_home;

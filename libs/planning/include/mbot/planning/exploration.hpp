@@ -46,6 +46,7 @@ struct FrontierLeft {
   int cells = 0;             // its size
   bool reachable = false;    // a cell near it can be reached at the planning clearance
   bool blacklisted = false;  // it was given up: unresolved at its target, or no path to it
+  bool unresolved = false;   // ... for good: the robot stood at its target and it stayed
 };
 
 struct ExplorationUpdate {
@@ -77,7 +78,7 @@ class Explorer {
     double x, y, until_s;
     int cells;  // the frontier's size when it was given up
   };
-  bool IsBlacklisted(const Frontier& f, double t_s) const;
+  bool IsBlacklisted(const Frontier& f, double t_s, bool* for_good = nullptr) const;
   bool PathIsSafe(const motion::Pose2D& pose) const;
   bool SelectFrontier(const mapping::OccupancyGrid& map, const motion::Pose2D& pose, double t_s, ExplorationUpdate* u);
   void Fail(const std::string& reason, ExplorationUpdate* u);
