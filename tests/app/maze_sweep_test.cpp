@@ -71,10 +71,12 @@ TEST(MazeSweep, EveryGeneratedMazeExploredMappedAndHome) {
   const int first = EnvInt("MBOT_MAZE_FIRST", 1), last = EnvInt("MBOT_MAZE_LAST", 100);
   ASSERT_LE(first, last);
   std::vector<double> coverage, time_s, error_m, rtf, cells;
-  int completed = 0, collisions = 0, runs_with_collision = 0;
+  int completed = 0, collisions = 0, runs_with_collision = 0, within = 0;
+  std::string outside;
   std::ostringstream rows;
-  rows << "| maze | cells | loops | dead ends | longest corridor | state | coverage % | time s | home error m | "
-          "collisions |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  rows << "| maze | cells | loops | dead ends | longest corridor | state | coverage % | walls % | time s | home error "
+          "m | "
+          "collisions |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (int seed = first; seed <= last; ++seed) {
     SCOPED_TRACE("generated maze " + std::to_string(seed));
     const MazeRun r = ExploreGeneratedMaze(seed);
@@ -88,23 +90,31 @@ TEST(MazeSweep, EveryGeneratedMazeExploredMappedAndHome) {
         rtf.push_back(Get(r.json, {"sim_seconds"}) / r.wall_s);
     cells.push_back(r.maze.cols * r.maze.rows);
     completed += done, collisions += col, runs_with_collision += col > 0;
+    const double walls = Get(r.json, {"map", "wall_precision"});
+    if (done && col == 0 && cov >= 0.99 && walls >= 0.95 && err <= 0.05) {
+      ++within;
+    } else {
+      outside += (outside.empty() ? "" : ", ") + std::to_string(seed);
+    }
     char row[256];
-    std::snprintf(row, sizeof row, "| %d | %dx%d | %d | %d | %d | %s | %.1f | %.1f | %.3f | %d |\n", seed, r.maze.cols,
-                  r.maze.rows, r.maze.Loops(), r.maze.DeadEnds(), r.maze.LongestCorridor(),
-                  done ? "completed" : "NOT completed", 100 * cov, t, err, col);
+    std::snprintf(row, sizeof row, "| %d | %dx%d | %d | %d | %d | %s | %.1f | %.1f | %.1f | %.3f | %d |\n", seed,
+                  r.maze.cols, r.maze.rows, r.maze.Loops(), r.maze.DeadEnds(), r.maze.LongestCorridor(),
+                  done ? "completed" : "NOT completed", 100 * cov, 100 * walls, t, err, col);
     rows << row;
   }
   const int n = static_cast<int>(coverage.size());
   ASSERT_GT(n, 0);
-  char summary[1024];
-  std::snprintf(summary, sizeof summary,
-                "| mazes | completed | coverage min / median %% | time median [min, max] s | runs with a collision | "
-                "home error median / max m | real-time factor median |\n|---|---|---|---|---|---|---|\n"
-                "| %d (seeds %d-%d) | %d | %.1f / %.1f | %.0f [%.0f, %.0f] | %d | %.3f / %.3f | %.0f |\n",
-                n, first, last, completed, 100 * *std::min_element(coverage.begin(), coverage.end()),
-                100 * Median(coverage), Median(time_s), *std::min_element(time_s.begin(), time_s.end()),
-                *std::max_element(time_s.begin(), time_s.end()), runs_with_collision, Median(error_m),
-                *std::max_element(error_m.begin(), error_m.end()), Median(rtf));
+  char summary[2048];
+  std::snprintf(
+      summary, sizeof summary,
+      "| mazes | within every bound | completed | coverage min / median %% | time median [min, max] s | "
+      "runs with a collision | home error median / max m | real-time factor median |\n"
+      "|---|---|---|---|---|---|---|---|\n"
+      "| %d (seeds %d-%d) | %d (outside: %s) | %d | %.1f / %.1f | %.0f [%.0f, %.0f] | %d | %.3f / %.3f | %.0f |\n",
+      n, first, last, within, outside.empty() ? "none" : outside.c_str(), completed,
+      100 * *std::min_element(coverage.begin(), coverage.end()), 100 * Median(coverage), Median(time_s),
+      *std::min_element(time_s.begin(), time_s.end()), *std::max_element(time_s.begin(), time_s.end()),
+      runs_with_collision, Median(error_m), *std::max_element(error_m.begin(), error_m.end()), Median(rtf));
   const std::string table = std::string(summary) + "\n" + rows.str();
   std::cout << table;
   const char* md = std::getenv("MBOT_MAZE_SWEEP_MD");
