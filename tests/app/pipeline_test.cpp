@@ -32,7 +32,8 @@ TEST(PipelineTest, UnknownStageTypeListsTheKnownOnes) {
   const auto e = ErrorOf(std::string(kBase) + "[s]\ntype = nope\n");
   EXPECT_NE(
       e.find(
-          "t.ini:6: [s] type: unknown stage type 'nope' (known: action_model_fit, astar_test, exploration, "
+          "t.ini:6: [s] type: unknown stage type 'nope' (known: action_model_fit, astar_test, camera_calibration, "
+          "exploration, "
           "inspect, lcm_bridge, map_writer, maze_generator, mission, motor_calibration, movingai_benchmark, odometry, "
           "recorder, referee, slam, trajectory_writer)"),
       std::string::npos)

@@ -7,11 +7,22 @@ namespace mbot::app {
 
 const std::vector<StageType>& StageTypes() {
   static const std::vector<StageType> types = [] {
-    std::vector<StageType> t = {InspectStageType(),        TrajectoryWriterStageType(),  MapWriterStageType(),
-                                AStarTestStageType(),      MovingAiBenchmarkStageType(), ExplorationStageType(),
-                                SlamStageType(),           OdometryStageType(),          MotorCalibrationStageType(),
-                                ActionModelFitStageType(), MissionStageType(),           RefereeStageType(),
-                                RecorderStageType(),       LcmBridgeStageType(),         MazeGeneratorStageType()};
+    std::vector<StageType> t = {InspectStageType(),
+                                TrajectoryWriterStageType(),
+                                MapWriterStageType(),
+                                AStarTestStageType(),
+                                MovingAiBenchmarkStageType(),
+                                ExplorationStageType(),
+                                SlamStageType(),
+                                OdometryStageType(),
+                                MotorCalibrationStageType(),
+                                ActionModelFitStageType(),
+                                MissionStageType(),
+                                RefereeStageType(),
+                                RecorderStageType(),
+                                LcmBridgeStageType(),
+                                MazeGeneratorStageType(),
+                                CameraCalibrationStageType()};
     std::sort(t.begin(), t.end(), [](const StageType& a, const StageType& b) { return a.name < b.name; });
     return t;
   }();

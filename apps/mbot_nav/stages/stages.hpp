@@ -20,5 +20,6 @@ StageType RefereeStageType();
 StageType RecorderStageType();
 StageType LcmBridgeStageType();
 StageType MazeGeneratorStageType();
+StageType CameraCalibrationStageType();
 
 }  // namespace mbot::app

@@ -1,0 +1,206 @@
+#include "mbot/vision/camera_calibration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "mbot/common/atomic_file.hpp"
+#include "mbot/common/files.hpp"
+
+namespace mbot::vision {
+namespace {
+
+std::string Lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+bool IsImageFile(const std::filesystem::path& p) {
+  const std::string e = Lower(p.extension().string());
+  return e == ".png" || e == ".jpg" || e == ".jpeg" || e == ".bmp" || e == ".pgm" || e == ".ppm" || e == ".tif" ||
+         e == ".tiff";
+}
+
+int Flags(const ChessboardOptions& o) {
+  int f = 0;
+  if (o.fix_aspect_ratio) f |= cv::CALIB_FIX_ASPECT_RATIO;
+  if (o.zero_tangent_dist) f |= cv::CALIB_ZERO_TANGENT_DIST;
+  if (o.fix_principal_point) f |= cv::CALIB_FIX_PRINCIPAL_POINT;
+  if (o.fix_k3) f |= cv::CALIB_FIX_K3;
+  if (o.rational_model) f |= cv::CALIB_RATIONAL_MODEL;
+  return f;
+}
+
+}  // namespace
+
+int CalibrationResult::UsedViews() const {
+  return static_cast<int>(std::count_if(views.begin(), views.end(), [](const CalibrationView& v) { return v.found; }));
+}
+
+CalibrationResult CalibrateChessboard(const std::vector<std::pair<std::string, cv::Mat>>& images,
+                                      const ChessboardOptions& o) {
+  if (o.inner_cols < 2 || o.inner_rows < 2) throw std::invalid_argument("chessboard: at least 2 x 2 inner corners");
+  if (!(o.square_m > 0)) throw std::invalid_argument("chessboard: square size must be positive");
+  if (o.fix_aspect_ratio && !(o.aspect_ratio > 0)) throw std::invalid_argument("chessboard: aspect_ratio must be > 0");
+  CalibrationResult r;
+  r.flags = Flags(o);
+  const cv::Size pattern(o.inner_cols, o.inner_rows);
+  std::vector<cv::Point3f> board;  // the corners on the board plane, OpenCV's order (row by row)
+  for (int i = 0; i < o.inner_rows; ++i) {
+    for (int j = 0; j < o.inner_cols; ++j)
+      board.emplace_back(static_cast<float>(j * o.square_m), static_cast<float>(i * o.square_m), 0.0f);
+  }
+  std::vector<std::vector<cv::Point3f>> object_points;
+  std::vector<std::vector<cv::Point2f>> image_points;
+  std::vector<size_t> used;  // index into r.views of each calibrated view
+  for (const auto& [name, image] : images) {
+    if (image.empty()) throw std::invalid_argument(name + ": empty image");
+    if (r.image_width == 0) r.image_width = image.cols, r.image_height = image.rows;
+    if (image.cols != r.image_width || image.rows != r.image_height) {
+      throw std::invalid_argument(name + ": " + std::to_string(image.cols) + " x " + std::to_string(image.rows) +
+                                  " differs from the first view's " + std::to_string(r.image_width) + " x " +
+                                  std::to_string(r.image_height));
+    }
+    cv::Mat gray;
+    if (image.channels() == 1) {
+      gray = image;
+    } else {
+      cv::cvtColor(image, gray, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+    }
+    CalibrationView v;
+    v.name = name;
+    // OpenCV's calibration sample: adaptive threshold, normalised image, fast check first.
+    v.found = cv::findChessboardCorners(
+        gray, pattern, v.corners,
+        cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_FAST_CHECK | cv::CALIB_CB_NORMALIZE_IMAGE);
+    if (v.found) {
+      const int w = std::max(1, o.subpixel_half_window);
+      cv::cornerSubPix(gray, v.corners, cv::Size(w, w), cv::Size(-1, -1),
+                       cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 0.0001));
+      object_points.push_back(board);
+      image_points.push_back(v.corners);
+      used.push_back(r.views.size());
+    } else {
+      v.corners.clear();
+    }
+    r.views.push_back(std::move(v));
+  }
+  if (static_cast<int>(used.size()) < std::max(1, o.min_views)) {
+    r.verdict = "not calibrated: the board was found in " + std::to_string(used.size()) + " of " +
+                std::to_string(images.size()) + " views, fewer than min_views = " + std::to_string(o.min_views);
+    return r;
+  }
+  r.camera_matrix = cv::Mat::eye(3, 3, CV_64F);
+  if (o.fix_aspect_ratio) r.camera_matrix.at<double>(0, 0) = o.aspect_ratio;
+  r.distortion = cv::Mat::zeros(o.rational_model ? 8 : 5, 1, CV_64F);
+  std::vector<cv::Mat> rvecs, tvecs;
+  cv::calibrateCamera(object_points, image_points, cv::Size(r.image_width, r.image_height), r.camera_matrix,
+                      r.distortion, rvecs, tvecs, r.flags | cv::CALIB_FIX_K4 | cv::CALIB_FIX_K5);
+  r.calibrated = true;
+  // Reprojection errors as OpenCV's sample reports them: per view sqrt(mean squared distance), and
+  // overall sqrt(sum of squared distances / all points).
+  double total2 = 0.0;
+  size_t total_points = 0;
+  for (size_t k = 0; k < used.size(); ++k) {
+    std::vector<cv::Point2f> projected;
+    cv::projectPoints(object_points[k], rvecs[k], tvecs[k], r.camera_matrix, r.distortion, projected);
+    const double e = cv::norm(image_points[k], projected, cv::NORM_L2);
+    total2 += e * e;
+    total_points += projected.size();
+    r.views[used[k]].error_px = std::sqrt(e * e / projected.size());
+  }
+  r.avg_error_px = std::sqrt(total2 / total_points);
+  r.accepted = r.avg_error_px <= o.max_error_px;
+  char b[160];
+  std::snprintf(b, sizeof b, "%s: mean reprojection error %.3f px %s %.2f px over %d views",
+                r.accepted ? "accepted" : "not accepted", r.avg_error_px, r.accepted ? "<=" : ">", o.max_error_px,
+                static_cast<int>(used.size()));
+  r.verdict = b;
+  return r;
+}
+
+std::vector<std::pair<std::string, cv::Mat>> ReadViews(const std::string& path, int every) {
+  namespace fs = std::filesystem;
+  std::vector<std::pair<std::string, cv::Mat>> views;
+  if (!fs::exists(path)) throw std::runtime_error(path + ": no such file or folder");
+  if (fs::is_directory(path)) {
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(path)) {
+      if (e.is_regular_file() && IsImageFile(e.path())) files.push_back(e.path());
+    }
+    std::sort(files.begin(), files.end());
+    for (const fs::path& f : files) {
+      cv::Mat m = cv::imread(f.string(), cv::IMREAD_UNCHANGED);
+      if (m.empty()) throw std::runtime_error(f.string() + ": not a readable image");
+      views.emplace_back(f.filename().string(), m);
+    }
+    if (views.empty()) throw std::runtime_error(path + ": no image files in the folder");
+    return views;
+  }
+  if (IsImageFile(path)) {
+    cv::Mat m = cv::imread(path, cv::IMREAD_UNCHANGED);
+    if (m.empty()) throw std::runtime_error(path + ": not a readable image");
+    views.emplace_back(fs::path(path).filename().string(), m);
+    return views;
+  }
+  cv::VideoCapture video(path);
+  if (!video.isOpened())
+    throw std::runtime_error(path + ": neither an image, a folder of images nor a video OpenCV can open");
+  cv::Mat frame;
+  for (int n = 0; video.read(frame); ++n) {
+    if (n % std::max(1, every) == 0) views.emplace_back("frame " + std::to_string(n), frame.clone());
+  }
+  if (views.empty()) throw std::runtime_error(path + ": the video has no frames");
+  return views;
+}
+
+void WriteCameraYaml(const CalibrationResult& r, const ChessboardOptions& o, const std::string& path) {
+  const std::string tmp = TempPathFor(path);
+  {
+    cv::FileStorage fs(tmp, cv::FileStorage::WRITE);
+    if (!fs.isOpened()) throw std::runtime_error(path + ": cannot be written");
+    fs << "nframes" << r.UsedViews();
+    fs << "image_width" << r.image_width << "image_height" << r.image_height;
+    fs << "board_width" << o.inner_cols << "board_height" << o.inner_rows << "square_size" << o.square_m;
+    if (o.fix_aspect_ratio) fs << "aspectRatio" << o.aspect_ratio;
+    fs << "flags" << r.flags;
+    fs << "camera_matrix" << r.camera_matrix << "distortion_coefficients" << r.distortion;
+    fs << "avg_reprojection_error" << r.avg_error_px;
+    std::vector<float> per_view;
+    for (const CalibrationView& v : r.views) {
+      if (v.found) per_view.push_back(static_cast<float>(v.error_px));
+    }
+    fs << "per_view_reprojection_errors" << cv::Mat(per_view, true);
+  }
+  CommitFile(tmp, path);
+}
+
+CalibrationResult ReadCameraYaml(const std::string& path) {
+  RequireReadableFile(path);  // "no such file", "permission denied", … before OpenCV says less
+  cv::FileStorage fs(path, cv::FileStorage::READ);
+  if (!fs.isOpened()) throw std::runtime_error(path + ": cannot be read as an OpenCV YAML/XML file");
+  CalibrationResult r;
+  auto need = [&](const char* key) {
+    cv::FileNode n = fs[key];
+    if (n.empty()) throw std::runtime_error(path + ": no '" + key + "'");
+    return n;
+  };
+  need("image_width") >> r.image_width;
+  need("image_height") >> r.image_height;
+  need("camera_matrix") >> r.camera_matrix;
+  need("distortion_coefficients") >> r.distortion;
+  if (r.camera_matrix.rows != 3 || r.camera_matrix.cols != 3)
+    throw std::runtime_error(path + ": camera_matrix is not 3 x 3");
+  if (!fs["avg_reprojection_error"].empty()) fs["avg_reprojection_error"] >> r.avg_error_px;
+  r.calibrated = true;
+  return r;
+}
+
+}  // namespace mbot::vision

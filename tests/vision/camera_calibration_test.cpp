@@ -1,0 +1,101 @@
+#include "mbot/vision/camera_calibration.hpp"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace mbot::vision {
+namespace {
+
+// A 9 x 6 inner-corner chessboard (10 x 7 squares of 40 px, a white margin) seen by a pinhole camera
+// (fx = fy = 600, cx = 320, cy = 240, no distortion) from a pose: the board texture warped by the
+// homography K [r1 r2 t] S, S taking texture pixels to board metres (square_m per 40 px).
+cv::Mat RenderView(const cv::Vec3d& rvec, const cv::Vec3d& tvec, double square_m) {
+  const int sq = 40, margin = 40;
+  cv::Mat board(7 * sq + 2 * margin, 10 * sq + 2 * margin, CV_8UC1, cv::Scalar(255));
+  for (int r = 0; r < 7; ++r) {
+    for (int c = 0; c < 10; ++c) {
+      if ((r + c) % 2 == 0) board(cv::Rect(margin + c * sq, margin + r * sq, sq, sq)).setTo(0);
+    }
+  }
+  const cv::Matx33d K(600, 0, 320, 0, 600, 240, 0, 0, 1);
+  cv::Matx33d R;
+  cv::Rodrigues(rvec, R);
+  const cv::Matx33d Rt(R(0, 0), R(0, 1), tvec[0], R(1, 0), R(1, 1), tvec[1], R(2, 0), R(2, 1), tvec[2]);
+  const double s = square_m / sq;
+  const cv::Matx33d S(s, 0, -(margin + sq) * s, 0, s, -(margin + sq) * s, 0, 0, 1);  // first inner corner at 0
+  cv::Mat view;
+  cv::warpPerspective(board, view, cv::Mat(K * Rt * S), cv::Size(640, 480), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                      cv::Scalar(128));
+  return view;
+}
+
+std::vector<std::pair<std::string, cv::Mat>> SyntheticViews() {
+  std::vector<std::pair<std::string, cv::Mat>> views;
+  const double sq = 0.025;
+  const cv::Vec3d rotations[] = {{0.0, 0.0, 0.0},   {0.3, 0.0, 0.05},  {-0.3, 0.1, 0.0},   {0.0, 0.35, -0.1},
+                                 {0.1, -0.35, 0.1}, {0.25, 0.25, 0.0}, {-0.2, -0.25, 0.2}, {0.35, -0.1, -0.15}};
+  int k = 0;
+  for (const cv::Vec3d& r : rotations) {
+    views.emplace_back("view" + std::to_string(k++), RenderView(r, {-0.1, -0.06, 0.45}, sq));
+  }
+  return views;
+}
+
+TEST(CameraCalibrationTest, RecoversTheIntrinsicsOfSyntheticViews) {
+  ChessboardOptions o;
+  const CalibrationResult r = CalibrateChessboard(SyntheticViews(), o);
+  ASSERT_TRUE(r.calibrated) << r.verdict;
+  EXPECT_EQ(r.UsedViews(), 8);
+  EXPECT_TRUE(r.accepted) << r.verdict;
+  EXPECT_NEAR(r.camera_matrix.at<double>(0, 0), 600.0, 6.0);
+  EXPECT_NEAR(r.camera_matrix.at<double>(1, 1), 600.0, 6.0);
+  EXPECT_NEAR(r.camera_matrix.at<double>(0, 2), 320.0, 3.0);
+  EXPECT_NEAR(r.camera_matrix.at<double>(1, 2), 240.0, 3.0);
+  EXPECT_LT(r.avg_error_px, 0.2);
+}
+
+TEST(CameraCalibrationTest, ViewsWithoutABoardAreRejectedAndTooFewFail) {
+  auto views = SyntheticViews();
+  views.resize(3);
+  views.emplace_back("blank", cv::Mat(480, 640, CV_8UC1, cv::Scalar(200)));
+  ChessboardOptions o;
+  const CalibrationResult r = CalibrateChessboard(views, o);
+  EXPECT_FALSE(r.calibrated);
+  EXPECT_FALSE(r.accepted);
+  ASSERT_EQ(r.views.size(), 4u);
+  EXPECT_FALSE(r.views[3].found);
+  EXPECT_NE(r.verdict.find("found in 3 of 4 views, fewer than min_views = 5"), std::string::npos) << r.verdict;
+}
+
+TEST(CameraCalibrationTest, ViewsOfDifferentSizesAreAnErrorNamingTheView) {
+  auto views = SyntheticViews();
+  views.emplace_back("small.png", cv::Mat(240, 320, CV_8UC1, cv::Scalar(0)));
+  try {
+    CalibrateChessboard(views, ChessboardOptions{});
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("small.png: 320 x 240 differs"), std::string::npos) << e.what();
+  }
+}
+
+TEST(CameraCalibrationTest, CameraYamlRoundTripsWithOpenCvKeys) {
+  const CalibrationResult r = CalibrateChessboard(SyntheticViews(), ChessboardOptions{});
+  ASSERT_TRUE(r.calibrated);
+  const std::string path = ::testing::TempDir() + "/camera_roundtrip.yaml";
+  WriteCameraYaml(r, ChessboardOptions{}, path);
+  cv::FileStorage fs(path, cv::FileStorage::READ);
+  for (const char* key : {"image_width", "image_height", "camera_matrix", "distortion_coefficients",
+                          "avg_reprojection_error", "per_view_reprojection_errors"}) {
+    EXPECT_FALSE(fs[key].empty()) << key;
+  }
+  const CalibrationResult back = ReadCameraYaml(path);
+  EXPECT_EQ(back.image_width, 640);
+  EXPECT_NEAR(back.camera_matrix.at<double>(0, 0), r.camera_matrix.at<double>(0, 0), 1e-9);
+  EXPECT_THROW(ReadCameraYaml(::testing::TempDir() + "/no_such_camera.yaml"), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace mbot::vision
