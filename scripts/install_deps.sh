@@ -10,6 +10,7 @@ packages=(
   libmrpt-dev libceres-dev liboctomap-dev
   liblcm-dev liblcm-bin libglib2.0-dev
   libopencv-dev libeigen3-dev
+  libapriltag-dev  # libs/vision: the AprilTag reference detector (AprilRobotics 3.3)
   libgtest-dev libgmock-dev libbenchmark-dev
   zlib1g-dev
   clang-format  # scripts/check_format.sh (ctest format.check)

@@ -3,7 +3,11 @@
 // (left_intrinsics.yml, made with a fixed aspect ratio of 1).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <fstream>
 #include <opencv2/core.hpp>
+#include <sstream>
 
 #include "mbot/common/config.hpp"
 #include "mbot/vision/camera_calibration.hpp"
@@ -47,6 +51,82 @@ TEST(VisionRegression, TooStrictAcceptanceFailsTheRunSayingWhy) {
   }
   EXPECT_FALSE(std::filesystem::exists(::testing::TempDir() + "/calibrate_camera_strict/camera.yaml"));
   EXPECT_TRUE(std::filesystem::exists(::testing::TempDir() + "/calibrate_camera_strict/calibration.json"));
+}
+
+}  // namespace
+}  // namespace mbot::app
+
+namespace mbot::app {
+namespace {
+
+struct Tag {
+  int id;
+  std::array<cv::Point2d, 4> corners;
+};
+
+std::vector<Tag> ReadTags(const std::string& csv_text) {
+  std::vector<Tag> tags;
+  std::istringstream in(csv_text);
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    std::replace(line.begin(), line.end(), ',', ' ');
+    std::istringstream f(line);
+    std::string image;
+    Tag t;
+    f >> image >> t.id;
+    for (auto& c : t.corners) f >> c.x >> c.y;
+    tags.push_back(t);
+  }
+  return tags;
+}
+
+// The reference library's test file: "id, (x0 y0), (x1 y1), (x2 y2), (x3 y3)" per line.
+std::vector<Tag> ReadExpected(const std::string& path) {
+  std::vector<Tag> tags;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    for (char& ch : line) {
+      if (ch == ',' || ch == '(' || ch == ')') ch = ' ';
+    }
+    std::istringstream f(line);
+    Tag t;
+    if (!(f >> t.id)) continue;
+    for (auto& c : t.corners) f >> c.x >> c.y;
+    tags.push_back(t);
+  }
+  return tags;
+}
+
+cv::Point2d Centre(const Tag& t) { return (t.corners[0] + t.corners[1] + t.corners[2] + t.corners[3]) / 4.0; }
+
+// At the library's own test settings (decimate 1, no edge refinement): every tag, with its id, no
+// other detection, each corner within 0.25 px of the library's expected corner (its own suite asks
+// 0.1 px with its own JPEG reader).
+TEST(VisionRegression, TagDetectionFindsEveryTagOfTheLibrarysTestPhoto) {
+  const std::string csv = RunConfig("detect_tags.ini", "detect_tags_reference",
+                                    {"detect.decimate=1", "detect.refine_edges=false"}, "tags.csv");
+  const std::vector<Tag> got = ReadTags(csv);
+  const std::vector<Tag> expected = ReadExpected(Data("camera/apriltag/33369213973_9d9bb4cc96_c.txt"));
+  ASSERT_EQ(expected.size(), 12u);
+  ASSERT_EQ(got.size(), expected.size()) << csv;
+  double worst = 0.0;
+  std::vector<bool> used(got.size(), false);
+  for (const Tag& e : expected) {
+    size_t best = 0;
+    for (size_t i = 1; i < got.size(); ++i) {
+      if (cv::norm(Centre(got[i]) - Centre(e)) < cv::norm(Centre(got[best]) - Centre(e))) best = i;
+    }
+    EXPECT_FALSE(used[best]) << "two expected tags matched one detection";
+    used[best] = true;
+    EXPECT_EQ(got[best].id, e.id);
+    for (int k = 0; k < 4; ++k) worst = std::max(worst, cv::norm(got[best].corners[k] - e.corners[k]));
+  }
+  EXPECT_LE(worst, 0.25);
+  RecordProperty("worst_corner_error_px", std::to_string(worst));
+  // The shipped config (decimate 1, edges refined) finds them all too.
+  EXPECT_EQ(ReadTags(RunConfig("detect_tags.ini", "detect_tags_default", {}, "tags.csv")).size(), 12u);
 }
 
 }  // namespace

@@ -22,7 +22,8 @@ const std::vector<StageType>& StageTypes() {
                                 RecorderStageType(),
                                 LcmBridgeStageType(),
                                 MazeGeneratorStageType(),
-                                CameraCalibrationStageType()};
+                                CameraCalibrationStageType(),
+                                TagDetectionStageType()};
     std::sort(t.begin(), t.end(), [](const StageType& a, const StageType& b) { return a.name < b.name; });
     return t;
   }();

@@ -21,5 +21,6 @@ StageType RecorderStageType();
 StageType LcmBridgeStageType();
 StageType MazeGeneratorStageType();
 StageType CameraCalibrationStageType();
+StageType TagDetectionStageType();
 
 }  // namespace mbot::app

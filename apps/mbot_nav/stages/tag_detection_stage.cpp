@@ -1,0 +1,147 @@
+// `tag_detection`: AprilTag detection (libs/vision, the reference detector) on a folder of images,
+// one image or a video. Writes tags.csv (image,id,x0,y0,x1,y1,x2,y2,x3,y3,margin: corners in the
+// library's order and pixel convention), an annotated PNG per image (<name>_tags.png; not for video
+// frames unless asked) and tags.json (counts, time per frame).
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "mbot/common/atomic_file.hpp"
+#include "mbot/common/config.hpp"
+#include "mbot/common/log.hpp"
+#include "mbot/vision/apriltag_detector.hpp"
+#include "mbot/vision/camera_calibration.hpp"
+#include "report.hpp"
+#include "stages.hpp"
+
+namespace mbot::app {
+namespace {
+
+struct TagDetectionOptions {
+  vision::TagDetectorOptions detector;
+  std::string images;
+  int every = 1;
+  bool annotate = true;
+  int timing_repeats = 1;  // detect each frame this many times; the time is their median
+};
+
+cv::Mat Annotated(const cv::Mat& image, const std::vector<vision::TagDetection>& tags) {
+  cv::Mat shown;
+  if (image.channels() == 1) {
+    cv::cvtColor(image, shown, cv::COLOR_GRAY2BGR);
+  } else if (image.channels() == 4) {
+    cv::cvtColor(image, shown, cv::COLOR_BGRA2BGR);
+  } else {
+    shown = image.clone();
+  }
+  for (const vision::TagDetection& t : tags) {
+    for (int k = 0; k < 4; ++k) {
+      cv::line(shown, t.corners[k], t.corners[(k + 1) % 4], k == 0 ? cv::Scalar(0, 0, 255) : cv::Scalar(0, 200, 0), 1,
+               cv::LINE_AA);
+    }
+    cv::putText(shown, std::to_string(t.id), t.center, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(255, 0, 0), 1,
+                cv::LINE_AA);
+  }
+  return shown;
+}
+
+class TagDetectionStage : public Stage {
+ public:
+  explicit TagDetectionStage(TagDetectionOptions o) : o_(std::move(o)), detector_(o_.detector) {}
+  void OnEvent(const drivers::Event&) override {}
+
+  void Finish(const RunContext& ctx, bool interrupted) override {
+    if (interrupted) return;
+    const auto views = vision::ReadViews(o_.images, o_.every);
+    const bool video = !views.empty() && views[0].first.rfind("frame ", 0) == 0;
+    std::ostringstream csv;
+    csv << "image,id,x0,y0,x1,y1,x2,y2,x3,y3,margin\n";
+    std::vector<double> ms;
+    size_t total = 0;
+    std::map<int, int> per_id;
+    for (const auto& [name, image] : views) {
+      auto t0 = std::chrono::steady_clock::now();
+      const std::vector<vision::TagDetection> tags = detector_.Detect(image);
+      std::vector<double> runs = {
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count()};
+      for (int k = 1; k < o_.timing_repeats; ++k) {  // the same frame again, for the time only
+        t0 = std::chrono::steady_clock::now();
+        const size_t again = detector_.Detect(image).size();
+        runs.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+        if (again != tags.size()) mbot::log::Warn("tag_detection: " + name + " gave a different count when repeated");
+      }
+      std::nth_element(runs.begin(), runs.begin() + runs.size() / 2, runs.end());
+      ms.push_back(runs[runs.size() / 2]);
+      total += tags.size();
+      for (const vision::TagDetection& t : tags) {
+        ++per_id[t.id];
+        char row[320];
+        std::snprintf(row, sizeof row, "%s,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f\n", name.c_str(), t.id,
+                      t.corners[0].x, t.corners[0].y, t.corners[1].x, t.corners[1].y, t.corners[2].x, t.corners[2].y,
+                      t.corners[3].x, t.corners[3].y, t.margin);
+        csv << row;
+      }
+      if (o_.annotate && !video) {
+        const std::string stem = std::filesystem::path(name).stem().string();
+        const std::string png = ctx.output_dir + "/" + stem + "_tags.png";
+        const std::string tmp = TempPathFor(png);
+        if (!cv::imwrite(tmp, Annotated(image, tags))) throw std::runtime_error(png + ": cannot be written");
+        CommitFile(tmp, png);
+      }
+    }
+    WriteFileAtomically(ctx.output_dir + "/tags.csv", [&](std::ostream& out) { out << csv.str(); });
+    std::vector<double> sorted = ms;
+    std::sort(sorted.begin(), sorted.end());
+    const double median = sorted[sorted.size() / 2];
+    std::ostringstream j;
+    j << "{\n  \"images\": " << JsonString(o_.images) << ",\n  \"family\": " << JsonString(o_.detector.family)
+      << ",\n  \"decimate\": " << Num(o_.detector.decimate)
+      << ", \"refine_edges\": " << (o_.detector.refine_edges ? "true" : "false")
+      << ", \"threads\": " << o_.detector.threads << ",\n  \"frames\": " << views.size()
+      << ", \"detections\": " << total << ",\n  \"per_id\": {";
+    bool first = true;
+    for (const auto& [id, n] : per_id) j << (first ? "" : ", ") << "\"" << id << "\": " << n, first = false;
+    j << "},\n  \"ms_per_frame\": {\"median\": " << Num(median) << ", \"max\": " << Num(sorted.back()) << "}\n}\n";
+    WriteFileAtomically(ctx.output_dir + "/tags.json", [&](std::ostream& out) { out << j.str(); });
+    std::printf("tag_detection: %zu tags in %zu frames (%s), median %.2f ms per frame; tags.csv, tags.json in %s\n",
+                total, views.size(), o_.detector.family.c_str(), median, ctx.output_dir.c_str());
+  }
+
+ private:
+  TagDetectionOptions o_;
+  vision::TagDetector detector_;
+};
+
+}  // namespace
+
+StageType TagDetectionStageType() {
+  return {
+      "tag_detection",
+      "AprilTag detection with the reference detector on a folder of images, an image or a video; writes "
+      "tags.csv, tags.json and annotated PNGs",
+      [](config::Section& s) -> std::unique_ptr<Stage> {
+        TagDetectionOptions o;
+        vision::TagDetectorOptions& d = o.detector;
+        o.images = s.RequirePath("images", "a folder of images (sorted by name), one image, or a video");
+        o.every = s.GetInt("every_nth_frame", o.every, "video: use every n-th frame", 1, 100000);
+        o.timing_repeats = s.GetInt("timing_repeats", o.timing_repeats,
+                                    "detect each frame this many times and report the median time", 1, 10000);
+        o.annotate = s.GetBool("annotate", o.annotate, "write <image>_tags.png with the tags drawn (not for video)");
+        d.family = s.GetChoice("family", d.family,
+                               {"tag36h11", "tag25h9", "tag16h5", "tagStandard41h12", "tagCircle21h7"}, "tag family");
+        d.max_bits_corrected =
+            s.GetInt("max_bits_corrected", d.max_bits_corrected, "bit errors the decoder corrects", 0, 3);
+        d.decimate = s.GetDouble("decimate", d.decimate, "find quads on an image this much smaller", 1.0, 16.0);
+        d.blur_sigma = s.GetDouble("blur_sigma", d.blur_sigma, "Gaussian blur before quads (0: none) [px]", 0.0, 10.0);
+        d.refine_edges = s.GetBool("refine_edges", d.refine_edges, "snap quad edges to strong gradients");
+        d.decode_sharpening =
+            s.GetDouble("decode_sharpening", d.decode_sharpening, "sharpening of the decoded bits", 0.0, 10.0);
+        d.threads = s.GetInt("threads", d.threads, "detector threads", 1, 64);
+        return std::make_unique<TagDetectionStage>(o);
+      }};
+}
+
+}  // namespace mbot::app

@@ -1,0 +1,122 @@
+#include "mbot/vision/apriltag_detector.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+extern "C" {
+#include <apriltag.h>
+#include <tag16h5.h>
+#include <tag25h9.h>
+#include <tag36h11.h>
+#include <tagCircle21h7.h>
+#include <tagStandard41h12.h>
+#include <common/image_u8.h>
+}
+
+namespace mbot::vision {
+
+namespace {
+
+struct Family {
+  const char* name;
+  apriltag_family_t* (*create)();
+  void (*destroy)(apriltag_family_t*);
+};
+
+const Family kFamilies[] = {{"tag36h11", tag36h11_create, tag36h11_destroy},
+                            {"tag25h9", tag25h9_create, tag25h9_destroy},
+                            {"tag16h5", tag16h5_create, tag16h5_destroy},
+                            {"tagStandard41h12", tagStandard41h12_create, tagStandard41h12_destroy},
+                            {"tagCircle21h7", tagCircle21h7_create, tagCircle21h7_destroy}};
+
+const Family& FindFamily(const std::string& name) {
+  std::string known;
+  for (const Family& f : kFamilies) {
+    if (name == f.name) return f;
+    known += (known.empty() ? "" : ", ") + std::string(f.name);
+  }
+  throw std::invalid_argument("tag family '" + name + "' is not one of: " + known);
+}
+
+}  // namespace
+
+cv::Mat TagImage(const std::string& family, int id, int pixels_per_cell) {
+  const Family& f = FindFamily(family);
+  apriltag_family_t* fam = f.create();
+  if (id < 0 || static_cast<uint32_t>(id) >= fam->ncodes || pixels_per_cell < 1) {
+    const uint32_t n = fam->ncodes;
+    f.destroy(fam);
+    throw std::invalid_argument(family + ": id " + std::to_string(id) + " outside 0.." + std::to_string(n - 1) +
+                                " (or pixels_per_cell < 1)");
+  }
+  image_u8_t* im = apriltag_to_image(fam, id);
+  cv::Mat cells(im->height, im->width, CV_8UC1, im->buf, im->stride);
+  cv::Mat out;
+  cv::resize(cells, out, cv::Size(), pixels_per_cell, pixels_per_cell, cv::INTER_NEAREST);
+  image_u8_destroy(im);
+  f.destroy(fam);
+  return out;
+}
+
+struct TagDetector::Impl {
+  apriltag_family_t* family = nullptr;
+  void (*destroy_family)(apriltag_family_t*) = nullptr;
+  apriltag_detector_t* detector = nullptr;
+};
+
+TagDetector::TagDetector(const TagDetectorOptions& o) : options_(o), impl_(std::make_unique<Impl>()) {
+  const Family& f = FindFamily(o.family);
+  impl_->family = f.create();
+  impl_->destroy_family = f.destroy;
+  if (!(o.decimate >= 1.0)) throw std::invalid_argument("tag detector: decimate must be >= 1");
+  if (o.threads < 1) throw std::invalid_argument("tag detector: threads must be >= 1");
+  if (o.max_bits_corrected < 0 || o.max_bits_corrected > 3)
+    throw std::invalid_argument("tag detector: max_bits_corrected must be 0..3");
+  impl_->detector = apriltag_detector_create();
+  apriltag_detector_add_family_bits(impl_->detector, impl_->family, o.max_bits_corrected);
+  impl_->detector->quad_decimate = static_cast<float>(o.decimate);
+  impl_->detector->quad_sigma = static_cast<float>(o.blur_sigma);
+  impl_->detector->refine_edges = o.refine_edges;
+  impl_->detector->decode_sharpening = o.decode_sharpening;
+  impl_->detector->nthreads = o.threads;
+}
+
+TagDetector::~TagDetector() {
+  if (impl_->detector) apriltag_detector_destroy(impl_->detector);
+  if (impl_->family) impl_->destroy_family(impl_->family);
+}
+
+std::vector<TagDetection> TagDetector::Detect(const cv::Mat& image) const {
+  if (image.empty() || image.depth() != CV_8U) throw std::invalid_argument("tag detector: needs an 8-bit image");
+  cv::Mat gray;
+  if (image.channels() == 1) {
+    gray = image.isContinuous() ? image : image.clone();
+  } else {
+    cv::cvtColor(image, gray, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+  }
+  image_u8_t im{gray.cols, gray.rows, static_cast<int32_t>(gray.step[0]), gray.data};
+  zarray_t* found = apriltag_detector_detect(impl_->detector, &im);
+  std::vector<TagDetection> out;
+  for (int i = 0; i < zarray_size(found); ++i) {
+    apriltag_detection_t* d = nullptr;
+    zarray_get(found, i, &d);
+    TagDetection t;
+    t.id = d->id;
+    t.hamming = d->hamming;
+    t.margin = d->decision_margin;
+    for (int k = 0; k < 4; ++k) t.corners[k] = {d->p[k][0], d->p[k][1]};
+    t.center = {d->c[0], d->c[1]};
+    out.push_back(t);
+  }
+  apriltag_detections_destroy(found);
+  std::sort(out.begin(), out.end(), [](const TagDetection& a, const TagDetection& b) {
+    if (a.id != b.id) return a.id < b.id;
+    if (a.center.x != b.center.x) return a.center.x < b.center.x;
+    return a.center.y < b.center.y;
+  });
+  return out;
+}
+
+}  // namespace mbot::vision
