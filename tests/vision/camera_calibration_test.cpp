@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -95,6 +97,22 @@ TEST(CameraCalibrationTest, CameraYamlRoundTripsWithOpenCvKeys) {
   EXPECT_EQ(back.image_width, 640);
   EXPECT_NEAR(back.camera_matrix.at<double>(0, 0), r.camera_matrix.at<double>(0, 0), 1e-9);
   EXPECT_THROW(ReadCameraYaml(::testing::TempDir() + "/no_such_camera.yaml"), std::runtime_error);
+  // A file that is not a camera file, or one missing a key, names the file (and the key).
+  const std::string bad = ::testing::TempDir() + "/camera_bad.yaml";
+  std::ofstream(bad) << "%YAML:1.0\n---\nimage_width: [1, 2\n";
+  try {
+    ReadCameraYaml(bad);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
+  }
+  std::ofstream(bad) << "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n";
+  try {
+    ReadCameraYaml(bad);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no 'camera_matrix'"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -184,23 +184,27 @@ void WriteCameraYaml(const CalibrationResult& r, const ChessboardOptions& o, con
 
 CalibrationResult ReadCameraYaml(const std::string& path) {
   RequireReadableFile(path);  // "no such file", "permission denied", … before OpenCV says less
-  cv::FileStorage fs(path, cv::FileStorage::READ);
-  if (!fs.isOpened()) throw std::runtime_error(path + ": cannot be read as an OpenCV YAML/XML file");
-  CalibrationResult r;
-  auto need = [&](const char* key) {
-    cv::FileNode n = fs[key];
-    if (n.empty()) throw std::runtime_error(path + ": no '" + key + "'");
-    return n;
-  };
-  need("image_width") >> r.image_width;
-  need("image_height") >> r.image_height;
-  need("camera_matrix") >> r.camera_matrix;
-  need("distortion_coefficients") >> r.distortion;
-  if (r.camera_matrix.rows != 3 || r.camera_matrix.cols != 3)
-    throw std::runtime_error(path + ": camera_matrix is not 3 x 3");
-  if (!fs["avg_reprojection_error"].empty()) fs["avg_reprojection_error"] >> r.avg_error_px;
-  r.calibrated = true;
-  return r;
+  try {
+    cv::FileStorage fs(path, cv::FileStorage::READ);
+    if (!fs.isOpened()) throw std::runtime_error(path + ": cannot be read as an OpenCV YAML/XML file");
+    CalibrationResult r;
+    auto need = [&](const char* key) {
+      cv::FileNode n = fs[key];
+      if (n.empty()) throw std::runtime_error(path + ": no '" + key + "'");
+      return n;
+    };
+    need("image_width") >> r.image_width;
+    need("image_height") >> r.image_height;
+    need("camera_matrix") >> r.camera_matrix;
+    need("distortion_coefficients") >> r.distortion;
+    if (r.camera_matrix.rows != 3 || r.camera_matrix.cols != 3 || r.camera_matrix.type() != CV_64F)
+      throw std::runtime_error(path + ": camera_matrix is not a 3 x 3 matrix of doubles");
+    if (!fs["avg_reprojection_error"].empty()) fs["avg_reprojection_error"] >> r.avg_error_px;
+    r.calibrated = true;
+    return r;
+  } catch (const cv::Exception& e) {  // OpenCV's parser: a message of its own, naming no file
+    throw std::runtime_error(path + ": not a camera file OpenCV can parse (" + e.msg + ")");
+  }
 }
 
 }  // namespace mbot::vision
