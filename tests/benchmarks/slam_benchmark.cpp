@@ -3,7 +3,10 @@
 //    likelihood field, all cores and one thread) beside MRPT 2.5's CMonteCarloLocalization2D
 //    (likelihood field "Thrun", standard proposal, systematic resampling) on the same map, scans,
 //    odometry and particle counts;
-//  - log-odds map update: scans inserted per second at 0.05 m.
+//  - log-odds map update: scans inserted per second at 0.05 m;
+//  - the lookup bound: a plain likelihood-lookup loop (random poses, a 200 x 200 float table, 209
+//    beams, one core) over as many particle-beam pairs as the filter weighs, the floor the filter's
+//    update is compared with (issue 20); its counter evals_per_s is particle-beam lookups a second.
 // Every timed iteration starts from the raw scan, so turning it into the filter's points (our
 // DeskewScan + Prepare; MRPT's observation object and the point cloud it caches) is timed on both
 // sides. Wall time is reported (UseRealTime) because our filter runs on several threads.
@@ -17,6 +20,7 @@
 #include <exception>
 #include <iterator>
 #include <memory>
+#include <random>
 #include <string>
 #include <utility>
 #include <variant>
@@ -338,6 +342,49 @@ void BM_MapUpdate_LogOdds(benchmark::State& state) {
 
 const int64_t kParticleCounts[] = {100, 500, 1000, 10000, 100000};
 
+// Args: particle count. One core, no filter: for each random pose, rotate and translate 209 beam end
+// points into a 200 x 200 table and sum what they hit (clamped to the table) — the work of weighing
+// a particle, with nothing else.
+void BM_LookupBound(benchmark::State& state) {
+  const int particles = static_cast<int>(state.range(0));
+  constexpr int kSide = 200, kBeams = 209;
+  std::mt19937 rng(kSeed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  std::vector<float> table(kSide * kSide);
+  for (float& v : table) v = -unit(rng);
+  std::vector<float> bx(kBeams), by(kBeams);
+  for (int k = 0; k < kBeams; ++k) {
+    const float a = 6.2831853f * k / kBeams, r = 5.0f + 40.0f * unit(rng);  // ranges in cells
+    bx[k] = r * std::cos(a), by[k] = r * std::sin(a);
+  }
+  struct P {
+    float x, y, c, s;
+  };
+  std::vector<P> poses(particles);
+  for (P& p : poses) {
+    const float th = 6.2831853f * unit(rng);
+    p = {50.0f + 100.0f * unit(rng), 50.0f + 100.0f * unit(rng), std::cos(th), std::sin(th)};
+  }
+  std::vector<float> weight(particles);
+  for (auto _ : state) {
+    for (int i = 0; i < particles; ++i) {
+      const P& p = poses[i];
+      float acc = 0.0f;
+      for (int k = 0; k < kBeams; ++k) {
+        const int cx = std::min(kSide - 1, std::max(0, static_cast<int>(p.x + p.c * bx[k] - p.s * by[k])));
+        const int cy = std::min(kSide - 1, std::max(0, static_cast<int>(p.y + p.s * bx[k] + p.c * by[k])));
+        acc += table[cy * kSide + cx];
+      }
+      weight[i] = acc;
+    }
+    benchmark::DoNotOptimize(weight.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["particles"] = particles;
+  state.counters["evals_per_s"] =
+      benchmark::Counter(static_cast<double>(particles) * kBeams, benchmark::Counter::kIsIterationInvariantRate);
+}
+
 void OursArgs(benchmark::internal::Benchmark* b) {
   for (int64_t threads : {0, 1}) {
     for (int64_t n : kParticleCounts) b->Args({n, threads});
@@ -359,6 +406,7 @@ BENCHMARK(BM_ParticleFilter_MRPT)
     ->UseRealTime()
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_MapUpdate_LogOdds)->UseRealTime()->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_LookupBound)->Apply(MrptArgs)->ArgNames({"particles"})->UseRealTime()->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 
