@@ -50,6 +50,12 @@ bool Explorer::IsBlacklisted(const Frontier& f, double t_s, bool* for_good) cons
   return found;
 }
 
+void Explorer::DropBlacklisted(double t_s) {
+  frontiers_.erase(
+      std::remove_if(frontiers_.begin(), frontiers_.end(), [&](const Frontier& f) { return IsBlacklisted(f, t_s); }),
+      frontiers_.end());
+}
+
 bool Explorer::PathIsSafe(const motion::Pose2D& pose) const {
   if (path_.size() < 2) return true;
   // The waypoint the robot is heading to: the end of the path segment nearest to it.
@@ -173,13 +179,8 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
   };
 
   if (state_ == ExplorationState::kExploring) {
-    auto drop_blacklisted = [&] {
-      frontiers_.erase(std::remove_if(frontiers_.begin(), frontiers_.end(),
-                                      [&](const Frontier& f) { return IsBlacklisted(f, t_s); }),
-                       frontiers_.end());
-    };
     frontiers_ = FindFrontiers(map, options_.frontier);
-    drop_blacklisted();
+    DropBlacklisted(t_s);
     bool need = path_.empty();
     std::string why;
     if (!need && target_frontier_) {
@@ -219,7 +220,7 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
     }
     if (need) {
       if (!why.empty()) u.reason += (u.reason.empty() ? "" : "; ") + why;
-      drop_blacklisted();  // the frontier blacklisted just now drops out of the candidates
+      DropBlacklisted(t_s);  // the frontier blacklisted just now drops out of the candidates
       target_frontier_.reset();
       reached_at_s_ = -1;
       path_.clear();
@@ -239,10 +240,7 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
     // What the robot saw on the way home (or a frontier whose blacklisting ran out) may have opened
     // a frontier it can reach: it goes back to exploring rather than stopping early.
     frontiers_ = FindFrontiers(map, options_.frontier);
-    frontiers_.erase(
-        std::remove_if(frontiers_.begin(), frontiers_.end(), [&](const Frontier& f) { return IsBlacklisted(f, t_s); }),
-        frontiers_.end());
-    const std::vector<motion::Pose2D> way_home = path_;
+    DropBlacklisted(t_s);
     if (off > options_.home_tolerance_m && !frontiers_.empty() && SelectFrontier(map, pose, t_s, &u)) {
       state_ = ExplorationState::kExploring;
       u.reason = "a frontier is reachable again; " + u.reason;
@@ -261,9 +259,7 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
                                         [](const Blacklisted& b) { return std::isfinite(b.until_s); }),
                          blacklist_.end());
         frontiers_ = FindFrontiers(map, options_.frontier);
-        frontiers_.erase(std::remove_if(frontiers_.begin(), frontiers_.end(),
-                                        [&](const Frontier& f) { return IsBlacklisted(f, t_s); }),
-                         frontiers_.end());
+        DropBlacklisted(t_s);
         if (SelectFrontier(map, pose, t_s, &u)) {
           state_ = ExplorationState::kExploring;
           left_.clear();
@@ -271,7 +267,6 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
           u.state = state_;
           return u;
         }
-        path_.clear();
       }
       if (left_.empty()) {
         state_ = ExplorationState::kCompleted;
@@ -291,8 +286,7 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
                           static_cast<double>(unresolved)) +
                    Format(", %.0f without a path) at", static_cast<double>(left_.size() - unresolved), 0.0) + where;
       }
-    } else {
-      path_ = way_home;
+    } else {  // SelectFrontier found nothing: path_ is still the way home
       if (path_.empty()) {
         plan_home("");
       } else if (!PathIsSafe(pose)) {

@@ -6,6 +6,22 @@
 
 namespace mbot::planning {
 
+namespace {
+
+// Calls visit(n) for each of cell c's 8 neighbours inside a w × h grid (row-major indices).
+template <typename Visit>
+void ForEachNeighbour8(int c, int w, int h, Visit visit) {
+  const int cx = c % w, cy = c / w;
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int nx = cx + dx, ny = cy + dy;
+      if ((dx != 0 || dy != 0) && nx >= 0 && ny >= 0 && nx < w && ny < h) visit(ny * w + nx);
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<Frontier> FindFrontiers(const mapping::OccupancyGrid& map, const FrontierOptions& options) {
   const int w = map.width(), h = map.height();
   const auto& cells = map.cells();
@@ -33,18 +49,12 @@ std::vector<Frontier> FindFrontiers(const mapping::OccupancyGrid& map, const Fro
     for (size_t q = 0; q < queue.size(); ++q) {
       const int c = queue[q];
       f.cells.push_back(c);
-      const int cx = c % w, cy = c / w;
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int nx = cx + dx, ny = cy + dy;
-          if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
-          const int n = ny * w + nx;
-          if (state[n] == 1) {
-            state[n] = 2;
-            queue.push_back(n);
-          }
+      ForEachNeighbour8(c, w, h, [&](int n) {
+        if (state[n] == 1) {
+          state[n] = 2;
+          queue.push_back(n);
         }
-      }
+      });
     }
     if (f.size() < options.min_cells) continue;
     double sx = 0.0, sy = 0.0;
@@ -98,11 +108,12 @@ std::vector<FrontierGoal> RankFrontierGoals(const std::vector<Frontier>& frontie
   // behind a wall that is near the frontier as the crow flies but shows nothing of it; and a
   // frontier is judged by its nearest cell, not its centroid (which a long frontier, or one along a
   // faint band, may put inside a wall).
+  // ring_of holds the index of the frontier whose search reached a cell, so no reset is needed
+  // between frontiers.
   std::vector<int> ring_of(cells.size(), -1), ring, next;
   for (int i = 0; i < static_cast<int>(frontiers.size()); ++i) {
     const Frontier& f = frontiers[i];
     ring.assign(f.cells.begin(), f.cells.end());
-    std::vector<int> touched = ring;
     for (int c : ring) ring_of[c] = i;
     int best = -1;
     for (int r = 0; r <= radius_cells && !ring.empty() && best < 0; ++r) {
@@ -111,22 +122,14 @@ std::vector<FrontierGoal> RankFrontierGoals(const std::vector<Frontier>& frontie
       }
       next.clear();
       for (int c : ring) {
-        const int cx = c % w, cy = c / w;
-        for (int dy = -1; dy <= 1; ++dy) {
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int nx = cx + dx, ny = cy + dy;
-            if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
-            const int n = ny * w + nx;
-            if (ring_of[n] == i || cells[n] >= 0) continue;
-            ring_of[n] = i;
-            touched.push_back(n);
-            next.push_back(n);
-          }
-        }
+        ForEachNeighbour8(c, w, h, [&](int n) {
+          if (ring_of[n] == i || cells[n] >= 0) return;
+          ring_of[n] = i;
+          next.push_back(n);
+        });
       }
       ring.swap(next);
     }
-    for (int c : touched) ring_of[c] = -1;
     if (best < 0) {
       if (unreachable) unreachable->push_back(i);
       continue;
