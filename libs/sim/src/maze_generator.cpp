@@ -227,29 +227,28 @@ std::string Maze::ToArena() const {
   auto emit = [&](double x0, double y0, double x1, double y1) {
     out << "wall " << Num(x0) << ' ' << Num(y0) << ' ' << Num(x1) << ' ' << Num(y1) << '\n';
   };
-  for (int j = 0; j <= rows; ++j) {  // horizontal lines, panels merged into straight walls
-    for (int i = 0; i < cols;) {
-      if (!HWall(i, j)) {
-        ++i;
+  // Panels merged into straight walls: each maximal run of panels [a, b) along a line is one wall.
+  auto runs = [](int n, auto wall, auto emit_run) {
+    for (int a = 0; a < n;) {
+      if (!wall(a)) {
+        ++a;
         continue;
       }
-      int e = i;
-      while (e < cols && HWall(e, j)) ++e;
-      emit(i * cell_m - h, j * cell_m - h, e * cell_m - h, j * cell_m - h);
-      i = e;
+      int b = a;
+      while (b < n && wall(b)) ++b;
+      emit_run(a, b);
+      a = b;
     }
+  };
+  for (int j = 0; j <= rows; ++j) {  // horizontal lines
+    runs(
+        cols, [&](int i) { return HWall(i, j); },
+        [&](int a, int b) { emit(a * cell_m - h, j * cell_m - h, b * cell_m - h, j * cell_m - h); });
   }
-  for (int i = 0; i <= cols; ++i) {
-    for (int j = 0; j < rows;) {
-      if (!VWall(i, j)) {
-        ++j;
-        continue;
-      }
-      int e = j;
-      while (e < rows && VWall(i, e)) ++e;
-      emit(i * cell_m - h, j * cell_m - h, i * cell_m - h, e * cell_m - h);
-      j = e;
-    }
+  for (int i = 0; i <= cols; ++i) {  // vertical lines
+    runs(
+        rows, [&](int j) { return VWall(i, j); },
+        [&](int a, int b) { emit(i * cell_m - h, a * cell_m - h, i * cell_m - h, b * cell_m - h); });
   }
   out << "pose start 0 0 " << Num(start_theta_deg) << '\n';
   return out.str();
