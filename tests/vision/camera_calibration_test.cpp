@@ -1,4 +1,5 @@
 #include "mbot/vision/camera_calibration.hpp"
+#include "mbot/vision/images.hpp"
 
 #include <gtest/gtest.h>
 
@@ -113,6 +114,16 @@ TEST(CameraCalibrationTest, CameraYamlRoundTripsWithOpenCvKeys) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("no 'camera_matrix'"), std::string::npos) << e.what();
   }
+}
+
+// Grey, BGR and BGRA views all come out as BGR to draw on (a colour camera's views once failed here).
+TEST(CameraCalibrationTest, ViewsOfAnyChannelCountDrawInColour) {
+  for (int type : {CV_8UC1, CV_8UC3, CV_8UC4}) {
+    const cv::Mat bgr = ToBgr(cv::Mat(4, 6, type, cv::Scalar::all(90)));
+    EXPECT_EQ(bgr.type(), CV_8UC3);
+    EXPECT_EQ(bgr.at<cv::Vec3b>(2, 3), cv::Vec3b(90, 90, 90));
+  }
+  EXPECT_THROW(WriteImage(cv::Mat(4, 4, CV_8UC1), ::testing::TempDir() + "/no_such_dir/x.png"), std::runtime_error);
 }
 
 }  // namespace

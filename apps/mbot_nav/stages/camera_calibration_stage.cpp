@@ -6,14 +6,13 @@
 // reprojection error above max_error_px) fails the run, saying why.
 #include <filesystem>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/vision/camera_calibration.hpp"
+#include "mbot/vision/images.hpp"
 #include "report.hpp"
 #include "stages.hpp"
 
@@ -25,12 +24,6 @@ struct CameraCalibrationOptions {
   std::string images;
   int every = 1;
 };
-
-void WritePng(const cv::Mat& image, const std::string& path) {
-  const std::string tmp = TempPathFor(path);
-  if (!cv::imwrite(tmp, image)) throw std::runtime_error(path + ": cannot be written");
-  CommitFile(tmp, path);
-}
 
 std::string Json(const vision::CalibrationResult& r, const CameraCalibrationOptions& o) {
   std::ostringstream j;
@@ -72,14 +65,13 @@ class CameraCalibrationStage : public Stage {
     WriteFileAtomically(dir + "/calibration.json", [&](std::ostream& out) { out << Json(r, o_); });
     for (size_t i = 0; i < r.views.size(); ++i) {
       if (!r.views[i].found) continue;
-      cv::Mat shown;
-      cv::cvtColor(views[i].second, shown, views[i].second.channels() == 1 ? cv::COLOR_GRAY2BGR : cv::COLOR_BGRA2BGR);
+      cv::Mat shown = vision::ToBgr(views[i].second);  // grey, BGR or BGRA views alike
       cv::drawChessboardCorners(shown, cv::Size(o_.board.inner_cols, o_.board.inner_rows), r.views[i].corners, true);
-      WritePng(shown, dir + "/calibration_corners.png");
+      vision::WriteImage(shown, dir + "/calibration_corners.png");
       if (r.calibrated) {
         cv::Mat undistorted;
         cv::undistort(views[i].second, undistorted, r.camera_matrix, r.distortion);
-        WritePng(undistorted, dir + "/calibration_undistorted.png");
+        vision::WriteImage(undistorted, dir + "/calibration_undistorted.png");
       }
       break;
     }

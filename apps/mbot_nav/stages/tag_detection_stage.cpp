@@ -5,15 +5,13 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <sstream>
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/vision/apriltag_detector.hpp"
-#include "mbot/vision/camera_calibration.hpp"
+#include "mbot/vision/images.hpp"
 #include "report.hpp"
 #include "stages.hpp"
 
@@ -27,26 +25,6 @@ struct TagDetectionOptions {
   bool annotate = true;
   int timing_repeats = 1;  // detect each frame this many times; the time is their median
 };
-
-cv::Mat Annotated(const cv::Mat& image, const std::vector<vision::TagDetection>& tags) {
-  cv::Mat shown;
-  if (image.channels() == 1) {
-    cv::cvtColor(image, shown, cv::COLOR_GRAY2BGR);
-  } else if (image.channels() == 4) {
-    cv::cvtColor(image, shown, cv::COLOR_BGRA2BGR);
-  } else {
-    shown = image.clone();
-  }
-  for (const vision::TagDetection& t : tags) {
-    for (int k = 0; k < 4; ++k) {
-      cv::line(shown, t.corners[k], t.corners[(k + 1) % 4], k == 0 ? cv::Scalar(0, 0, 255) : cv::Scalar(0, 200, 0), 1,
-               cv::LINE_AA);
-    }
-    cv::putText(shown, std::to_string(t.id), t.center, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(255, 0, 0), 1,
-                cv::LINE_AA);
-  }
-  return shown;
-}
 
 class TagDetectionStage : public Stage {
  public:
@@ -86,10 +64,7 @@ class TagDetectionStage : public Stage {
       }
       if (o_.annotate && !video) {
         const std::string stem = std::filesystem::path(name).stem().string();
-        const std::string png = ctx.output_dir + "/" + stem + "_tags.png";
-        const std::string tmp = TempPathFor(png);
-        if (!cv::imwrite(tmp, Annotated(image, tags))) throw std::runtime_error(png + ": cannot be written");
-        CommitFile(tmp, png);
+        vision::WriteImage(vision::DrawTags(image, tags), ctx.output_dir + "/" + stem + "_tags.png");
       }
     }
     WriteFileAtomically(ctx.output_dir + "/tags.csv", [&](std::ostream& out) { out << csv.str(); });

@@ -5,6 +5,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "mbot/vision/images.hpp"
+
 extern "C" {
 #include <apriltag.h>
 #include <tag16h5.h>
@@ -117,6 +119,19 @@ std::vector<TagDetection> TagDetector::Detect(const cv::Mat& image) const {
     return a.center.y < b.center.y;
   });
   return out;
+}
+
+cv::Mat DrawTags(const cv::Mat& image, const std::vector<TagDetection>& tags) {
+  cv::Mat shown = ToBgr(image);
+  for (const TagDetection& t : tags) {
+    for (int k = 0; k < 4; ++k) {
+      cv::line(shown, t.corners[k], t.corners[(k + 1) % 4], k == 0 ? cv::Scalar(0, 0, 255) : cv::Scalar(0, 200, 0), 1,
+               cv::LINE_AA);
+    }
+    cv::putText(shown, std::to_string(t.id), t.center, cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(255, 0, 0), 1,
+                cv::LINE_AA);
+  }
+  return shown;
 }
 
 }  // namespace mbot::vision

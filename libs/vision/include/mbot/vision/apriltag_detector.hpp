@@ -36,6 +36,9 @@ struct TagDetection {
 // std::invalid_argument naming an unknown family or an id outside it.
 cv::Mat TagImage(const std::string& family, int id, int pixels_per_cell);
 
+// `image` in colour with each tag's outline (its first edge, corner 0 to 1, in red) and id drawn.
+cv::Mat DrawTags(const cv::Mat& image, const std::vector<TagDetection>& tags);
+
 class TagDetector {
  public:
   // Throws std::invalid_argument naming an unknown family or an option out of range.

@@ -52,11 +52,6 @@ struct CalibrationResult {
 CalibrationResult CalibrateChessboard(const std::vector<std::pair<std::string, cv::Mat>>& images,
                                       const ChessboardOptions& options);
 
-// The views of `path`: every image file of a folder (sorted by name; .png .jpg .jpeg .bmp .pgm
-// .ppm .tif .tiff), one image file, or every `every`-th frame of a video. Throws std::runtime_error
-// naming the path when nothing can be read.
-std::vector<std::pair<std::string, cv::Mat>> ReadViews(const std::string& path, int every = 1);
-
 // camera.yaml in OpenCV's FileStorage format with OpenCV's key names (image_width, image_height,
 // camera_matrix, distortion_coefficients, avg_reprojection_error, per_view_reprojection_errors, and
 // the board and flags), written whole or not at all.
