@@ -131,6 +131,11 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
       "emit the map to later stages (planner, explorer) every k-th scan (0: never); the pose goes every scan", 0));
   o.octomap_height_m =
       s.GetDouble("octomap_height_m", o.octomap_height_m, "wall height in the OctoMap .bt (0: none)", 0.0);
+  o.tum_stamps = s.GetChoice("tum_time", "event", {"event", "stamp"},
+                             "times in the TUM files and for the relations: each scan's event time, or its own "
+                             "stamp (CARMEN logs read in file order)") == "stamp";
+  o.relations_file =
+      s.GetPath("relations", "", "score slam.tum on this Kuemmerle et al. .relations file (metrics.json 'relations')");
   return o;
 }
 

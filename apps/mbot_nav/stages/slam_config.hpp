@@ -52,6 +52,8 @@ struct SlamStageOptions {
   int publish_particles_every = 0;  // emit SLAM_PARTICLES every k-th scan (0: never)
   int publish_map_every = 5;        // emit the map to later stages every k-th scan (0: never)
   double octomap_height_m = 0.3;    // wall height in the OctoMap (0: no .bt)
+  bool tum_stamps = false;          // the TUM files and the relations use the scans' own stamps
+  std::string relations_file;       // a .relations file to score the trajectory on ("" = none)
 };
 
 SlamStageOptions ParseSlamStageOptions(config::Section& s);

@@ -52,7 +52,8 @@ bool SlamInputs::Add(const drivers::Event& in) {
       if (Accept(&lidar_channel_, o_.lidar_channel, ev)) {
         // How late the scan arrived: its stamp is the robot's clock, its event time the logger's.
         const int64_t latency = std::llabs(in.t_us - in.stamp_us) < 2'000'000 ? in.t_us - in.stamp_us : 0;
-        pending_.push_back(Scan{ev.t_us, previous_scan_us_, latency, std::get<drivers::LidarScan>(ev.payload)});
+        pending_.push_back(Scan{ev.t_us, previous_scan_us_, latency, in.stamp_us != 0 ? in.stamp_us : in.t_us,
+                                std::get<drivers::LidarScan>(ev.payload)});
         previous_scan_us_ = ev.t_us;
       }
       return true;

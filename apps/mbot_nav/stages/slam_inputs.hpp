@@ -26,6 +26,7 @@ class SlamInputs {
     int64_t t_us = 0;          // the scan's time (its last beam); lidar_time_offset is added on use
     int64_t previous_us = -1;  // the scan before, or -1
     int64_t latency_us = 0;    // arrival time − stamp when both share a clock, else 0
+    int64_t stamp_us = 0;      // the scan message's own stamp (its event time when it has none)
     drivers::LidarScan scan;
   };
 

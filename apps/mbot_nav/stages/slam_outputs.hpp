@@ -21,6 +21,7 @@ namespace mbot::app {
 // One processed scan.
 struct ScanRecord {
   int64_t t_us = 0;
+  int64_t stamp_us = 0;  // the scan's own stamp (tum_time = stamp)
   motion::Pose2D slam, odometry;
   bool updated = false;
   mapping::FilterStatus status;

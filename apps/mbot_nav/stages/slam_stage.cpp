@@ -60,6 +60,12 @@ class SlamStage : public Stage {
 
   void Finish(const RunContext& ctx, bool interrupted) override {
     ProcessReadyScans(true);
+    if (slam_.graph()) {
+      // Graph SLAM's poses are final only once the last loops are closed and the graph is solved.
+      slam_.Finish();
+      const std::vector<Pose2D> poses = slam_.Trajectory();
+      for (size_t i = 0; i < records_.size() && i < poses.size(); ++i) records_[i].slam = poses[i];
+    }
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
     if (records_.empty()) {
       mbot::log::Warn("slam: no scan was processed (lidar channel '" + inputs_->lidar_channel() + "', " +
@@ -114,6 +120,7 @@ class SlamStage : public Stage {
 
     ScanRecord r;
     r.t_us = t_end;
+    r.stamp_us = p.stamp_us + options_.lidar_time_offset_us;
     r.slam = step.pose;
     r.updated = step.filter_updated;
     r.status = step.status;
@@ -125,7 +132,8 @@ class SlamStage : public Stage {
     r.odometry = motion::InterpolateAt(inputs_->odometry(), t_end, max_gap, &odo) ? odo : end_pose;
     records_.push_back(r);
     Publish(r);
-    if (options_.particles_every > 0 && !mapping_only && records_.size() % options_.particles_every == 1) {
+    if (options_.particles_every > 0 && !mapping_only && !slam_.graph() &&
+        records_.size() % options_.particles_every == 1) {
       for (const mapping::Particle& q : slam_.filter().particles()) particle_snapshots_.push_back(q.pose);
     }
     TrackEvents(r);
@@ -160,7 +168,8 @@ class SlamStage : public Stage {
       bus_->Emit(this, drivers::Event{r.t_us, r.t_us, "SLAM_STATUS", EventKind::kSlamStatus,
                                       mapping::SlamStatus{state, options_.slam.mode, r.status.spread_m}});
     }
-    if (options_.publish_particles_every > 0 && records_.size() % options_.publish_particles_every == 0) {
+    if (options_.publish_particles_every > 0 && !slam_.graph() &&
+        records_.size() % options_.publish_particles_every == 0) {
       drivers::Particles p;
       for (const mapping::Particle& q : slam_.filter().particles())
         p.poses.push_back(q.pose), p.weights.push_back(q.weight);
@@ -231,8 +240,8 @@ class SlamStage : public Stage {
 
 StageType SlamStageType() {
   return {"slam",
-          "log-odds mapping, Monte-Carlo localization and full SLAM (mode = full_slam | localization | "
-          "mapping_only | action_only); writes the map, TUM trajectories and metrics.json",
+          "log-odds mapping, Monte-Carlo localization, full SLAM and graph SLAM (mode = full_slam | "
+          "localization | mapping_only | action_only | graph_slam); writes the map, TUM trajectories and metrics.json",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             return std::make_unique<SlamStage>(ParseSlamStageOptions(s));
           }};

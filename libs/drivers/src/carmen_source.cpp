@@ -134,7 +134,27 @@ CarmenSource::CarmenSource(const SourceOptions& options) : options_(options), ma
     diagnostics_.truncated_tail = true;
   }
   gzclose(f);
-  std::stable_sort(events_.begin(), events_.end(), [](const Event& a, const Event& b) { return a.t_us < b.t_us; });
+  if (options.carmen_file_order) {
+    // File order: a record's event time is its stamp, or just after the record before when the stamp
+    // runs backwards; the records of one line share it.
+    int64_t last = INT64_MIN;
+    for (size_t i = 0; i < events_.size(); ++i) {
+      Event& ev = events_[i];
+      if (i > 0 && ev.stamp_us == events_[i - 1].stamp_us) {
+        ev.t_us = last;
+        continue;
+      }
+      if (ev.stamp_us < last) ++backward_stamps_;
+      ev.t_us = i == 0 ? ev.stamp_us : std::max(ev.stamp_us, last + 1);
+      last = ev.t_us;
+    }
+    if (backward_stamps_ > 0) {
+      mbot::log::Info(options.path + ": " + std::to_string(backward_stamps_) +
+                      " records stamped before the record above them; kept in file order (carmen_order = file)");
+    }
+  } else {
+    std::stable_sort(events_.begin(), events_.end(), [](const Event& a, const Event& b) { return a.t_us < b.t_us; });
+  }
   std::map<std::string, int64_t> last_scan;
   for (const Event& ev : events_) {
     if (ev.kind != EventKind::kLidar) continue;

@@ -35,6 +35,7 @@ class CarmenSource : public Source {
   int64_t lines_ = 0;
   int64_t ignored_lines_ = 0;
   int64_t duplicate_stamps_ = 0;
+  int64_t backward_stamps_ = 0;  // carmen_order = file: records stamped before the one above
 };
 
 }  // namespace mbot::drivers

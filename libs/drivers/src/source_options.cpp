@@ -198,6 +198,9 @@ SourceOptions ParseSourceOptions(config::Section& s) {
   o.carmen_max_range_m =
       s.GetDouble("carmen_max_range_m", o.carmen_max_range_m,
                   "CARMEN FLASER range limit when the log's PARAM lines do not give one [m]", 0.1, 1000.0);
+  o.carmen_file_order = s.GetChoice("carmen_order", "stamp", {"stamp", "file"},
+                                    "CARMEN records in stamp order, or in file order with event times held "
+                                    "non-decreasing (stamps that run backwards)") == "file";
   o.reorder_window_us = static_cast<int64_t>(
       1e6 * s.GetDouble("reorder_window_s", o.reorder_window_us * 1e-6,
                         "LCM log records are re-sorted by event time within this window [s]", 0.0, 10.0));

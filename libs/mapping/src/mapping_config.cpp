@@ -135,20 +135,95 @@ ParticleFilterOptions ParseParticleFilterOptions(config::Section& s, SlamMode mo
   return f;
 }
 
+GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOptions& defaults) {
+  GraphSlamOptions g = defaults;
+  auto num = [&](const char* key, double def, const char* doc, double lo, double hi) {
+    return s.GetDouble(std::string("graph_") + key, def, doc, lo, hi);
+  };
+  auto count = [&](const char* key, int def, const char* doc, int lo, int hi) {
+    return static_cast<int>(s.GetInt(std::string("graph_") + key, def, doc, lo, hi));
+  };
+  g.submap.resolution_m = num("resolution_m", g.submap.resolution_m, "submap cell size", 0.005, 1.0);
+  g.submap.hit_odds = count("hit_odds", g.submap.hit_odds, "submaps: log-odds added to a ray's end cell", 0, 127);
+  g.submap.miss_odds = count("miss_odds", g.submap.miss_odds, "submaps: log-odds removed along a ray", 0, 127);
+  g.nodes_per_submap =
+      count("nodes_per_submap", g.nodes_per_submap,
+            "nodes inserted into a submap before the next starts (it is finished at twice this)", 1, 100000);
+  g.field_sigma_m = num("field_sigma_m", g.field_sigma_m, "the matching field's Gaussian width", 0.001, 10.0);
+  g.occupied_threshold = count("occupied_threshold", g.occupied_threshold,
+                               "submap cells above this log-odds are obstacles for matching", -127, 126);
+  g.point_spacing_m =
+      num("point_spacing_m", g.point_spacing_m, "thin a scan's points to this spacing (0: all)", 0.0, 10.0);
+  g.loop_point_spacing_m = num("loop_point_spacing_m", g.loop_point_spacing_m,
+                               "thin a node's points to this spacing for the loop-closure search", 0.0, 10.0);
+  g.min_points =
+      count("min_points", g.min_points, "scans with fewer returns are not matched (they are counted)", 1, 100000);
+  g.local_search = s.GetBool("graph_local_search", g.local_search,
+                             "front end: correlative search before the Ceres fit (false: the fit alone)");
+  g.local_window.linear_m = num("local_window_m", g.local_window.linear_m, "front end: search window, +-", 0.0, 10.0);
+  g.local_window.angular_rad =
+      num("local_window_rad", g.local_window.angular_rad, "front end: angular search window, +-", 0.0, M_PI);
+  g.refine.translation_weight =
+      num("translation_weight", g.refine.translation_weight, "Ceres fit: pull towards the search's position", 0.0, 1e9);
+  g.refine.rotation_weight =
+      num("rotation_weight", g.refine.rotation_weight, "Ceres fit: pull towards the search's heading", 0.0, 1e9);
+  g.refine.max_iterations = count("fit_iterations", g.refine.max_iterations, "Ceres fit: iterations", 1, 1000);
+  g.node_distance_m =
+      num("node_distance_m", g.node_distance_m, "a scan becomes a node after this much motion", 0.0, 100.0);
+  g.node_angle_rad = num("node_angle_rad", g.node_angle_rad, "... or this much turning", 0.0, M_PI);
+  g.local_translation_weight = num("local_translation_weight", g.local_translation_weight,
+                                   "weight of a node's position in its own submaps", 0.0, 1e12);
+  g.local_rotation_weight =
+      num("local_rotation_weight", g.local_rotation_weight, "weight of a node's heading in its own submaps", 0.0, 1e12);
+  g.consecutive_translation_weight = num("consecutive_translation_weight", g.consecutive_translation_weight,
+                                         "weight of consecutive nodes' relative position", 0.0, 1e12);
+  g.consecutive_rotation_weight = num("consecutive_rotation_weight", g.consecutive_rotation_weight,
+                                      "weight of consecutive nodes' relative heading", 0.0, 1e12);
+  g.loop_translation_weight =
+      num("loop_translation_weight", g.loop_translation_weight, "weight of a loop closure's position", 0.0, 1e12);
+  g.loop_rotation_weight =
+      num("loop_rotation_weight", g.loop_rotation_weight, "weight of a loop closure's heading", 0.0, 1e12);
+  g.loop_window.linear_m = num("loop_window_m", g.loop_window.linear_m, "loop closure: search window, +-", 0.0, 100.0);
+  g.loop_window.angular_rad =
+      num("loop_window_rad", g.loop_window.angular_rad, "loop closure: angular search window, +-", 0.0, M_PI);
+  g.loop_window.min_angular_step_rad =
+      num("loop_angular_step_rad", g.loop_window.min_angular_step_rad,
+          "loop closure: the finest angular step (0: one cell at the farthest point)", 0.0, 1.0);
+  g.loop_min_score = num("loop_min_score", g.loop_min_score, "a loop closure needs this match score (0..1)", 0.0, 1.0);
+  g.loop_max_distance_m = num("loop_max_distance_m", g.loop_max_distance_m,
+                              "search submaps whose origin lies this close to the node", 0.0, 1e6);
+  g.loop_every_nodes =
+      count("loop_every_nodes", g.loop_every_nodes, "search loop closures for every k-th node", 1, 100000);
+  g.loop_levels = count("loop_levels", g.loop_levels, "branch-and-bound levels of a finished submap", 1, 12);
+  g.graph.huber_scale =
+      num("huber_scale", g.graph.huber_scale,
+          "loop closures with a weighted residual beyond this are down-weighted (and reported)", 1e-6, 1e9);
+  g.graph.max_iterations = count("iterations", g.graph.max_iterations, "Ceres iterations per solve", 1, 10000);
+  g.final_iterations = count("final_iterations", g.final_iterations, "Ceres iterations of the last solve", 1, 100000);
+  g.optimize_every_nodes =
+      count("optimize_every_nodes", g.optimize_every_nodes, "solve the graph after this many new nodes", 1, 1000000);
+  g.background = s.GetBool("graph_background", g.background,
+                           "solve on a worker thread while scans go on (false: in line, deterministic)");
+  g.rerender_map = s.GetBool("graph_rerender_map", g.rerender_map,
+                             "re-render the published map from the optimised poses after each solve");
+  return g;
+}
+
 SlamOptions ParseSlamOptions(config::Section& s) {
   SlamOptions m;
-  m.mode =
-      s.GetEnum("mode", SlamMode::kFullSlam,
-                {{"full_slam", SlamMode::kFullSlam},
-                 {"localization", SlamMode::kLocalization},
-                 {"mapping_only", SlamMode::kMappingOnly},
-                 {"action_only", SlamMode::kActionOnly}},
-                "what runs: full SLAM, localization on a known map, mapping from known poses, or particles driven by "
-                "odometry alone");
+  m.mode = s.GetEnum("mode", SlamMode::kFullSlam,
+                     {{"full_slam", SlamMode::kFullSlam},
+                      {"localization", SlamMode::kLocalization},
+                      {"mapping_only", SlamMode::kMappingOnly},
+                      {"action_only", SlamMode::kActionOnly},
+                      {"graph_slam", SlamMode::kGraphSlam}},
+                     "what runs: full SLAM (particle filter), localization on a known map, mapping from known poses, "
+                     "particles driven by odometry alone, or graph SLAM (scan matching, pose graph, loop closure)");
   m.mapper = ParseMapperOptions(s);
   m.action = ParseActionModelOptions(s);
   m.sensor = ParseSensorModelOptions(s);
   m.filter = ParseParticleFilterOptions(s, m.mode);
+  if (m.mode == SlamMode::kGraphSlam) m.graph = ParseGraphSlamOptions(s);
   return m;
 }
 

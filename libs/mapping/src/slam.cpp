@@ -12,6 +12,7 @@ const char* ToString(SlamMode mode) {
     case SlamMode::kActionOnly: return "action-only";
     case SlamMode::kLocalization: return "localization";
     case SlamMode::kFullSlam: return "full SLAM";
+    case SlamMode::kGraphSlam: return "graph SLAM";
   }
   return "?";
 }
@@ -59,7 +60,9 @@ Slam::Slam(const SlamOptions& options, uint64_t seed)
       action_(options.action),
       sensor_(options.sensor),
       no_map_sensor_(options.sensor),
-      filter_(options.filter, seed) {}
+      filter_(options.filter, seed) {
+  if (options.mode == SlamMode::kGraphSlam) graph_ = std::make_unique<GraphSlam>(options.graph, options.mapper);
+}
 
 void Slam::SetMap(OccupancyGrid map) {
   mapper_.Reset(std::move(map));
@@ -70,6 +73,7 @@ void Slam::SetMap(OccupancyGrid map) {
 void Slam::Initialize(const motion::Pose2D& pose, const motion::Pose2D& odometry, double sigma_xy_m,
                       double sigma_theta_rad) {
   filter_.InitializeAt(pose, sigma_xy_m, sigma_theta_rad);
+  if (graph_) graph_->Initialize(pose, odometry);
   last_odometry_ = odometry;
   last_estimate_ = pose;
   initialized_ = true;
@@ -89,6 +93,11 @@ SlamStep Slam::ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2
                            const motion::Pose2D* reference) {
   if (!initialized_) throw std::logic_error("SLAM: ProcessScan before Initialize");
   SlamStep out;
+  if (graph_) {
+    out.pose = graph_->ProcessScan(rays, odometry);
+    out.filter_updated = true;
+    return out;
+  }
   if (options_.mode == SlamMode::kMappingOnly) {
     if (!reference) throw std::invalid_argument("mapping-only SLAM needs a reference pose per scan");
     out.pose = *reference;
@@ -118,6 +127,14 @@ SlamStep Slam::ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2
     sensor_stale_ = true;
   }
   return out;
+}
+
+void Slam::Finish() {
+  if (graph_) graph_->Finish();
+}
+
+std::vector<motion::Pose2D> Slam::Trajectory() const {
+  return graph_ ? graph_->Trajectory() : std::vector<motion::Pose2D>{};
 }
 
 }  // namespace mbot::mapping

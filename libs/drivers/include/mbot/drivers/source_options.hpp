@@ -49,6 +49,10 @@ struct SourceOptions {
   ChannelRoles roles;
   // CARMEN logs with old FLASER lines give no range limit; beams at or beyond it are no-returns.
   double carmen_max_range_m = 81.0;
+  // CARMEN records in the order of their stamps (stamp), or in the file's order (file) for logs whose
+  // stamps are arrival times that run backwards (the raw Intel log): each record's event time is then
+  // its stamp held non-decreasing along the file, and its stamp is kept as the message's own.
+  bool carmen_file_order = false;
   // LCM log records are re-sorted by event time within this window (lcm-logger writes them in
   // arrival order, which can run a few ms backwards).
   int64_t reorder_window_us = 100000;

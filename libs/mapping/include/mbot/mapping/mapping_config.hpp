@@ -3,6 +3,7 @@
 #pragma once
 
 #include "mbot/mapping/action_model.hpp"
+#include "mbot/mapping/graph_slam.hpp"
 #include "mbot/mapping/log_odds_mapper.hpp"
 #include "mbot/mapping/moving_scan.hpp"
 #include "mbot/mapping/particle_filter.hpp"
@@ -29,7 +30,9 @@ SensorModelOptions ParseSensorModelOptions(config::Section& section, const Senso
 // localization, off for the mapping modes.
 ParticleFilterOptions ParseParticleFilterOptions(config::Section& section, SlamMode mode,
                                                  const ParticleFilterOptions& defaults = {});
-// Key mode (full_slam | localization | mapping_only | action_only) and every key above but the scan's.
+// The graph-SLAM keys (graph_*): submaps, front end, constraint weights, loop closure, solves.
+GraphSlamOptions ParseGraphSlamOptions(config::Section& section, const GraphSlamOptions& defaults = {});
+// Key mode (full_slam | localization | mapping_only | action_only | graph_slam) and every key above but the scan's.
 // Throws config::ConfigError naming the section and key.
 SlamOptions ParseSlamOptions(config::Section& section);
 

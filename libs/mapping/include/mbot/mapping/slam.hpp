@@ -2,7 +2,8 @@
 //   mapping-only  poses come from outside (motion capture, a reference channel); scans build the map;
 //   action-only   particles follow odometry through the action model alone; scans build the map;
 //   localization  particles weighed against a known map, which is not changed;
-//   full SLAM     localization against the map built so far, then the scan is added at the estimate.
+//   full SLAM     localization against the map built so far, then the scan is added at the estimate;
+//   graph SLAM    scan-to-submap matching and a pose graph that closes loops (graph_slam.hpp), no particles.
 // Between filter updates (the robot has not moved enough) the pose follows odometry.
 #pragma once
 
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "mbot/mapping/action_model.hpp"
+#include "mbot/mapping/graph_slam.hpp"
 #include "mbot/mapping/log_odds_mapper.hpp"
 #include "mbot/mapping/moving_scan.hpp"
 #include "mbot/mapping/particle_filter.hpp"
@@ -19,7 +21,7 @@
 
 namespace mbot::mapping {
 
-enum class SlamMode { kMappingOnly, kActionOnly, kLocalization, kFullSlam };
+enum class SlamMode { kMappingOnly, kActionOnly, kLocalization, kFullSlam, kGraphSlam };
 const char* ToString(SlamMode mode);
 
 // What SLAM's pose is worth, published as SLAM_STATUS: the mapping modes map; localization has not
@@ -41,6 +43,7 @@ struct SlamOptions {
   ActionModelOptions action;
   SensorModelOptions sensor;
   ParticleFilterOptions filter;
+  GraphSlamOptions graph;  // graph SLAM only
 };
 
 struct SlamStep {
@@ -98,7 +101,13 @@ class Slam {
   SlamStep ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2D& odometry,
                        const motion::Pose2D* reference = nullptr);
 
-  const OccupancyGrid& map() const { return mapper_.map(); }
+  // Graph SLAM: closes the last loops and solves the graph (a no-op in the other modes).
+  void Finish();
+  // Graph SLAM: every scan's pose from the optimised graph, one per ProcessScan call; empty otherwise.
+  std::vector<motion::Pose2D> Trajectory() const;
+  const GraphSlam* graph() const { return graph_.get(); }
+
+  const OccupancyGrid& map() const { return graph_ ? graph_->map() : mapper_.map(); }
   const ParticleFilter& filter() const { return filter_; }
   const SlamOptions& options() const { return options_; }
   int64_t filter_updates() const { return filter_.updates(); }
@@ -112,6 +121,7 @@ class Slam {
   SensorModel sensor_;
   SensorModel no_map_sensor_;  // action-only: every particle weighs the same
   ParticleFilter filter_;
+  std::unique_ptr<GraphSlam> graph_;
   bool initialized_ = false;
   bool sensor_stale_ = true;
   motion::Pose2D last_odometry_;  // odometry at the last filter update

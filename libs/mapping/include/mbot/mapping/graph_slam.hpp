@@ -1,0 +1,171 @@
+// Graph SLAM for buildings (Hess et al., ICRA 2016, in outline): a front end that matches every scan
+// against the current submap (branch-and-bound correlative search in a small window, refined by
+// Ceres) and inserts the scans that moved far enough as nodes into two overlapping submaps of
+// `nodes_per_submap` nodes; a back end that searches loop closures of nodes against finished
+// submaps (branch and bound over a large window, accepted by score, refined by Ceres) and optimises
+// the pose graph with Ceres every `optimize_every_nodes` nodes — on a worker thread when
+// `background`, so the front end publishes each scan's pose at once. The map is the scans rendered
+// at the optimised poses.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "mbot/mapping/log_odds_mapper.hpp"
+#include "mbot/mapping/moving_scan.hpp"
+#include "mbot/mapping/pose_graph.hpp"
+#include "mbot/mapping/scan_matching.hpp"
+#include "mbot/motion/pose2d.hpp"
+
+namespace mbot::mapping {
+
+struct GraphSlamOptions {
+  // Submaps: their own log-odds grids in the front end's frame.
+  MapperOptions submap{5, 1, 0.05, 10.0, 10.0, 0.0, 0.0, true, 2.0};
+  int nodes_per_submap = 60;          // a submap is finished after 2× this many nodes
+  double field_sigma_m = 0.05;        // of the matching field
+  int occupied_threshold = 0;         // submap cells above this count as obstacles
+  double point_spacing_m = 0.0;       // thin the scan's points to this spacing (0: all)
+  double loop_point_spacing_m = 0.1;  // ... for the loop-closure search (its Ceres fit takes them all)
+  int min_points = 20;                // scans with fewer hits are not matched (counted)
+  // Front end.
+  bool local_search = true;  // correlative search before the Ceres fit
+  SearchWindow local_window{0.1, 0.2, 0.005};
+  RefineOptions refine;
+  // A scan becomes a node when it moved this far from the last node (or turned this much).
+  double node_distance_m = 0.1;
+  double node_angle_rad = 0.0175;
+  // Constraint weights.
+  double local_translation_weight = 1e5, local_rotation_weight = 1e5;
+  double consecutive_translation_weight = 1e5, consecutive_rotation_weight = 1e5;
+  double loop_translation_weight = 1.1e4, loop_rotation_weight = 1e5;
+  // Loop closure.
+  SearchWindow loop_window{3.0, 0.35, 0.005};
+  double loop_min_score = 0.55;
+  double loop_max_distance_m = 10.0;  // node to submap origin, by the current estimate
+  int loop_every_nodes = 5;           // search every k-th node
+  int loop_levels = 8;                // branch-and-bound levels of a finished submap
+  PoseGraphOptions graph{10.0, 50, 1};
+  int final_iterations = 200;
+  int optimize_every_nodes = 90;
+  bool background = true;
+  bool rerender_map = true;  // re-render the live map from the optimised poses after each solve
+};
+
+struct RejectedClosure {
+  int node = 0, submap = 0;
+  double score = 0, residual = 0;
+};
+
+struct GraphSlamStats {
+  int scans = 0, nodes = 0, submaps = 0, sparse_scans = 0;
+  int64_t loop_searches = 0, loop_closures = 0;
+  std::vector<RejectedClosure> rejected;  // by the robust loss, at the last solve
+  int optimizations = 0;
+  double optimize_s = 0, loop_search_s = 0, front_end_s = 0, render_s = 0;
+};
+
+class GraphSlam {
+ public:
+  explicit GraphSlam(const GraphSlamOptions& options, const MapperOptions& map_options);
+  ~GraphSlam();
+  GraphSlam(const GraphSlam&) = delete;
+  GraphSlam& operator=(const GraphSlam&) = delete;
+
+  void Initialize(const motion::Pose2D& pose, const motion::Pose2D& odometry);
+  bool initialized() const { return initialized_; }
+  // One scan (rays in the frame of the robot at the scan's end) with the odometry then; returns the
+  // scan's pose by the current estimate.
+  motion::Pose2D ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2D& odometry);
+  // Waits for the worker, closes the last loops, solves the graph to convergence, renders the map.
+  void Finish();
+
+  // Every scan's pose so far (one per ProcessScan call), from the optimised nodes.
+  std::vector<motion::Pose2D> Trajectory() const;
+  const OccupancyGrid& map() const { return map_.map(); }
+  const GraphSlamStats& stats() const { return stats_; }
+  const GraphSlamOptions& options() const { return options_; }
+
+ private:
+  struct Node {
+    motion::Pose2D local, global;
+    std::shared_ptr<const std::vector<ScanRay>> rays;
+    std::shared_ptr<const std::vector<Point2>> points, loop_points;
+    std::vector<int> submaps;  // it was inserted into
+  };
+  struct Submap {
+    motion::Pose2D local, global;            // local: a translation (the grid is axis-aligned in the local frame)
+    std::unique_ptr<LogOddsMapper> grid;     // while active
+    std::shared_ptr<const MatchGrid> field;  // for matching (finished: with loop_levels)
+    bool dirty = true;
+    bool finished = false;
+    int nodes = 0;
+  };
+  struct Search {
+    int node = 0, submap = 0;
+  };
+  // What a solve needs, copied, and what it returns.
+  struct Job {
+    std::vector<Search> searches;
+    std::vector<std::shared_ptr<const std::vector<Point2>>> search_points, search_loop_points;
+    std::vector<std::shared_ptr<const MatchGrid>> search_fields;
+    std::vector<motion::Pose2D> search_submap_local;
+    std::vector<motion::Pose2D> nodes, submaps;
+    std::vector<PoseConstraint> constraints;
+    std::vector<std::shared_ptr<const std::vector<ScanRay>>> rays;  // for the re-render
+    int iterations = 50;
+    // Out.
+    std::vector<PoseConstraint> found;
+    PoseGraphSummary summary;
+    int64_t searched = 0;
+    double search_s = 0, render_s = 0;
+    std::optional<LogOddsMapper> map;
+  };
+
+  void AddNode(const motion::Pose2D& local, std::shared_ptr<const std::vector<ScanRay>> rays,
+               std::shared_ptr<const std::vector<Point2>> points);
+  void FinishSubmap(int index);
+  void QueueSearches(int node, int submap);
+  std::unique_ptr<Job> MakeJob(int iterations, bool render);
+  void RunJob(Job* job) const;
+  void ApplyJob(Job* job);
+  void MaybeApplyFinished();
+  void WorkerLoop();
+  motion::Pose2D ToGlobal(const motion::Pose2D& local) const { return correction_.Compose(local); }
+
+  GraphSlamOptions options_;
+  MapperOptions map_options_;
+  bool initialized_ = false;
+  motion::Pose2D last_odometry_, last_local_;
+  motion::Pose2D correction_;  // global ⊕ local⁻¹, from the last solve
+  std::vector<Node> nodes_;
+  std::vector<Submap> submaps_;
+  std::vector<int> active_;  // submap indices, oldest first
+  std::vector<PoseConstraint> constraints_;
+  std::vector<Search> pending_;
+  int nodes_since_solve_ = 0;
+  struct ScanAnchor {
+    int node = 0;
+    motion::Pose2D relative;  // the scan's local pose in its node's local frame
+  };
+  std::vector<ScanAnchor> scans_;
+  LogOddsMapper map_;
+  GraphSlamStats stats_;
+
+  // The worker: one job at a time.
+  std::thread worker_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::unique_ptr<Job> job_;   // handed to the worker
+  std::unique_ptr<Job> done_;  // returned by it
+  bool busy_ = false, stop_ = false;
+};
+
+}  // namespace mbot::mapping

@@ -1,0 +1,307 @@
+#include "mbot/mapping/graph_slam.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace mbot::mapping {
+namespace {
+
+using motion::Pose2D;
+using Clock = std::chrono::steady_clock;
+
+double Since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// Levels a search over ± `linear_m` needs for its top level to cover the window in one block.
+int LevelsFor(double linear_m, double resolution_m) {
+  const int width = 2 * static_cast<int>(std::ceil(linear_m / resolution_m)) + 1;
+  int levels = 1;
+  while ((1 << (levels - 1)) < width && levels < 12) ++levels;
+  return levels;
+}
+
+}  // namespace
+
+GraphSlam::GraphSlam(const GraphSlamOptions& options, const MapperOptions& map_options)
+    : options_(options), map_options_(map_options), map_(map_options) {
+  if (options.nodes_per_submap < 1) throw std::invalid_argument("graph SLAM: nodes_per_submap must be at least 1");
+  if (options.optimize_every_nodes < 1)
+    throw std::invalid_argument("graph SLAM: optimize_every_nodes must be at least 1");
+  if (options.loop_every_nodes < 1) throw std::invalid_argument("graph SLAM: loop_every_nodes must be at least 1");
+  if (options.background) worker_ = std::thread(&GraphSlam::WorkerLoop, this);
+}
+
+GraphSlam::~GraphSlam() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+void GraphSlam::Initialize(const Pose2D& pose, const Pose2D& odometry) {
+  correction_ = pose;  // the front end's frame starts at the identity
+  last_local_ = Pose2D{};
+  last_odometry_ = odometry;
+  initialized_ = true;
+}
+
+Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& odometry) {
+  if (!initialized_) throw std::logic_error("graph SLAM: ProcessScan before Initialize");
+  MaybeApplyFinished();
+  const auto t0 = Clock::now();
+  Pose2D local = last_local_.Compose(last_odometry_.Inverse().Compose(odometry));
+  auto points = std::make_shared<const std::vector<Point2>>(ScanHitPoints(rays, options_.point_spacing_m));
+  ++stats_.scans;
+  const bool sparse = static_cast<int>(points->size()) < options_.min_points;
+  if (sparse) {
+    ++stats_.sparse_scans;
+  } else if (!active_.empty()) {
+    Submap& s = submaps_[active_.front()];
+    if (s.dirty) {
+      // The front end's window is a few cells: an exhaustive search of the finest level beats
+      // building the coarser ones on every insertion.
+      s.field =
+          std::make_shared<const MatchGrid>(s.grid->map(), options_.field_sigma_m, options_.occupied_threshold, 1);
+      s.dirty = false;
+    }
+    Pose2D start = local;
+    if (options_.local_search) {
+      const MatchResult m = MatchBranchAndBound(*s.field, *points, local, options_.local_window, 0.0);
+      if (m.found) start = m.pose;
+    }
+    local = RefineMatch(*s.field, *points, start, options_.refine);
+  }
+  last_local_ = local;
+  last_odometry_ = odometry;
+  bool make_node = nodes_.empty();
+  if (!make_node && !sparse) {
+    const Pose2D moved = nodes_.back().local.Inverse().Compose(local);
+    make_node =
+        std::hypot(moved.x, moved.y) >= options_.node_distance_m || std::abs(moved.theta) >= options_.node_angle_rad;
+  }
+  if (make_node) AddNode(local, std::make_shared<const std::vector<ScanRay>>(rays), points);
+  scans_.push_back({static_cast<int>(nodes_.size()) - 1, nodes_.back().local.Inverse().Compose(local)});
+  stats_.front_end_s += Since(t0);
+
+  if (nodes_since_solve_ >= options_.optimize_every_nodes) {
+    if (options_.background) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!busy_ && !done_) {
+        job_ = MakeJob(options_.graph.max_iterations, options_.rerender_map);
+        busy_ = true;
+        cv_.notify_all();
+      }
+    } else {
+      std::unique_ptr<Job> job = MakeJob(options_.graph.max_iterations, options_.rerender_map);
+      RunJob(job.get());
+      ApplyJob(job.get());
+    }
+  }
+  return ToGlobal(local);
+}
+
+void GraphSlam::AddNode(const Pose2D& local, std::shared_ptr<const std::vector<ScanRay>> rays,
+                        std::shared_ptr<const std::vector<Point2>> points) {
+  const int index = static_cast<int>(nodes_.size());
+  auto loop_points = std::make_shared<const std::vector<Point2>>(ScanHitPoints(*rays, options_.loop_point_spacing_m));
+  Node n{local, ToGlobal(local), std::move(rays), std::move(points), std::move(loop_points), {}};
+  if (active_.empty() || submaps_[active_.back()].nodes >= options_.nodes_per_submap) {
+    Submap s;
+    s.local = {local.x, local.y, 0.0};
+    s.global = ToGlobal(s.local);
+    MapperOptions grid = options_.submap;
+    grid.center_x_m = local.x;
+    grid.center_y_m = local.y;
+    s.grid = std::make_unique<LogOddsMapper>(grid);
+    submaps_.push_back(std::move(s));
+    active_.push_back(static_cast<int>(submaps_.size()) - 1);
+    ++stats_.submaps;
+  }
+  for (int si : active_) {
+    Submap& s = submaps_[si];
+    s.grid->Insert(*n.rays, local);
+    s.dirty = true;
+    ++s.nodes;
+    n.submaps.push_back(si);
+    constraints_.push_back({PoseConstraint::kIntraSubmap, si, index, s.local.Inverse().Compose(local),
+                            options_.local_translation_weight, options_.local_rotation_weight, 0.0});
+  }
+  if (index > 0) {
+    constraints_.push_back({PoseConstraint::kConsecutive, index - 1, index,
+                            nodes_[index - 1].local.Inverse().Compose(local), options_.consecutive_translation_weight,
+                            options_.consecutive_rotation_weight, 0.0});
+  }
+  nodes_.push_back(std::move(n));
+  map_.Insert(*nodes_.back().rays, nodes_.back().global);
+  ++nodes_since_solve_;
+  ++stats_.nodes;
+  if (submaps_[active_.front()].nodes >= 2 * options_.nodes_per_submap) {
+    const int finished = active_.front();
+    active_.erase(active_.begin());
+    FinishSubmap(finished);
+  }
+  if (index % options_.loop_every_nodes == 0) {
+    for (size_t si = 0; si < submaps_.size(); ++si) {
+      if (submaps_[si].finished) QueueSearches(index, static_cast<int>(si));
+    }
+  }
+}
+
+void GraphSlam::FinishSubmap(int index) {
+  Submap& s = submaps_[index];
+  // Cropped to what the submap saw: a finished submap keeps its levels for every later search.
+  s.field = std::make_shared<const MatchGrid>(
+      CropToKnown(s.grid->map(), 0.5), options_.field_sigma_m, options_.occupied_threshold,
+      std::min(options_.loop_levels, LevelsFor(options_.loop_window.linear_m, options_.submap.resolution_m)));
+  s.grid.reset();
+  s.finished = true;
+  s.dirty = false;
+  // The nodes before it may see it too (the robot came back to where it is now).
+  for (size_t node = 0; node < nodes_.size(); node += options_.loop_every_nodes) {
+    QueueSearches(static_cast<int>(node), index);
+  }
+}
+
+void GraphSlam::QueueSearches(int node, int submap) {
+  const Node& n = nodes_[node];
+  if (std::find(n.submaps.begin(), n.submaps.end(), submap) != n.submaps.end()) return;
+  const Submap& s = submaps_[submap];
+  if (std::hypot(n.global.x - s.global.x, n.global.y - s.global.y) > options_.loop_max_distance_m) return;
+  pending_.push_back({node, submap});
+}
+
+std::unique_ptr<GraphSlam::Job> GraphSlam::MakeJob(int iterations, bool render) {
+  auto job = std::make_unique<Job>();
+  job->searches = std::move(pending_);
+  pending_.clear();
+  for (const Search& q : job->searches) {
+    job->search_points.push_back(nodes_[q.node].points);
+    job->search_loop_points.push_back(nodes_[q.node].loop_points);
+    job->search_fields.push_back(submaps_[q.submap].field);
+    job->search_submap_local.push_back(submaps_[q.submap].local);
+  }
+  for (const Node& n : nodes_) job->nodes.push_back(n.global);
+  for (const Submap& s : submaps_) job->submaps.push_back(s.global);
+  job->constraints = constraints_;
+  if (render) {
+    for (const Node& n : nodes_) job->rays.push_back(n.rays);
+  }
+  job->iterations = iterations;
+  nodes_since_solve_ = 0;
+  return job;
+}
+
+void GraphSlam::RunJob(Job* job) const {
+  auto t0 = Clock::now();
+  for (size_t i = 0; i < job->searches.size(); ++i) {
+    const Search& q = job->searches[i];
+    const Pose2D& origin = job->search_submap_local[i];
+    // The node's pose in the submap's grid, by the current estimate.
+    const Pose2D guess = origin.Compose(job->submaps[q.submap].Inverse().Compose(job->nodes[q.node]));
+    const MatchResult m = MatchBranchAndBound(*job->search_fields[i], *job->search_loop_points[i], guess,
+                                              options_.loop_window, options_.loop_min_score);
+    ++job->searched;
+    if (!m.found) continue;
+    const Pose2D refined = RefineMatch(*job->search_fields[i], *job->search_points[i], m.pose, options_.refine);
+    job->found.push_back({PoseConstraint::kLoopClosure, q.submap, q.node, origin.Inverse().Compose(refined),
+                          options_.loop_translation_weight, options_.loop_rotation_weight, m.score});
+  }
+  job->search_s = Since(t0);
+  std::vector<PoseConstraint> all = job->constraints;
+  all.insert(all.end(), job->found.begin(), job->found.end());
+  PoseGraphOptions graph = options_.graph;
+  graph.max_iterations = job->iterations;
+  job->summary = OptimizePoseGraph(&job->nodes, &job->submaps, all, graph);
+  if (!job->rays.empty()) {
+    t0 = Clock::now();
+    LogOddsMapper map(map_options_);
+    for (size_t i = 0; i < job->rays.size(); ++i) map.Insert(*job->rays[i], job->nodes[i]);
+    job->map = std::move(map);
+    job->render_s = Since(t0);
+  }
+}
+
+void GraphSlam::ApplyJob(Job* job) {
+  const size_t n_old = job->nodes.size(), s_old = job->submaps.size();
+  if (n_old > 0) {
+    for (size_t i = 0; i < n_old; ++i) nodes_[i].global = job->nodes[i];
+    for (size_t i = 0; i < s_old; ++i) submaps_[i].global = job->submaps[i];
+    correction_ = job->nodes.back().Compose(nodes_[n_old - 1].local.Inverse());
+    for (size_t i = n_old; i < nodes_.size(); ++i) nodes_[i].global = ToGlobal(nodes_[i].local);
+    for (size_t i = s_old; i < submaps_.size(); ++i) submaps_[i].global = ToGlobal(submaps_[i].local);
+  }
+  stats_.rejected.clear();
+  std::vector<PoseConstraint> all = job->constraints;
+  all.insert(all.end(), job->found.begin(), job->found.end());
+  for (int idx : job->summary.rejected) {
+    const PoseConstraint& c = all[idx];
+    stats_.rejected.push_back({c.to, c.from, c.score, ConstraintResidual(c, job->nodes, job->submaps)});
+  }
+  constraints_.insert(constraints_.end(), job->found.begin(), job->found.end());
+  stats_.loop_searches += job->searched;
+  stats_.loop_closures += static_cast<int64_t>(job->found.size());
+  ++stats_.optimizations;
+  stats_.optimize_s += job->summary.seconds;
+  stats_.loop_search_s += job->search_s;
+  if (job->map) {
+    map_ = std::move(*job->map);
+    for (size_t i = n_old; i < nodes_.size(); ++i) map_.Insert(*nodes_[i].rays, nodes_[i].global);
+    stats_.render_s += job->render_s;
+  }
+}
+
+void GraphSlam::MaybeApplyFinished() {
+  std::unique_ptr<Job> done;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    done = std::move(done_);
+  }
+  if (done) ApplyJob(done.get());
+}
+
+void GraphSlam::WorkerLoop() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (true) {
+    cv_.wait(lock, [&] { return stop_ || job_; });
+    if (stop_) return;
+    std::unique_ptr<Job> job = std::move(job_);
+    lock.unlock();
+    RunJob(job.get());
+    lock.lock();
+    done_ = std::move(job);
+    busy_ = false;
+    cv_.notify_all();
+  }
+}
+
+void GraphSlam::Finish() {
+  if (!initialized_ || nodes_.empty()) return;
+  if (options_.background) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait(lock, [&] { return !busy_; });
+  }
+  MaybeApplyFinished();
+  const std::vector<int> active = active_;
+  active_.clear();
+  for (int si : active) FinishSubmap(si);
+  std::unique_ptr<Job> job = MakeJob(options_.final_iterations, false);
+  RunJob(job.get());
+  ApplyJob(job.get());
+  const auto t0 = Clock::now();
+  LogOddsMapper map(map_options_);
+  for (const Node& n : nodes_) map.Insert(*n.rays, n.global);
+  map_ = std::move(map);
+  stats_.render_s += Since(t0);
+}
+
+std::vector<Pose2D> GraphSlam::Trajectory() const {
+  std::vector<Pose2D> out;
+  out.reserve(scans_.size());
+  for (const ScanAnchor& a : scans_) out.push_back(nodes_[a.node].global.Compose(a.relative));
+  return out;
+}
+
+}  // namespace mbot::mapping
