@@ -82,8 +82,10 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
     make_node =
         std::hypot(moved.x, moved.y) >= options_.node_distance_m || std::abs(moved.theta) >= options_.node_angle_rad;
   }
-  if (make_node) AddNode(local, std::make_shared<const std::vector<ScanRay>>(rays), points);
-  scans_.push_back({static_cast<int>(nodes_.size()) - 1, nodes_.back().local.Inverse().Compose(local)});
+  auto shared_rays = std::make_shared<const std::vector<ScanRay>>(rays);
+  if (make_node) AddNode(local, shared_rays, points);
+  scans_.push_back({static_cast<int>(nodes_.size()) - 1, nodes_.back().local.Inverse().Compose(local), shared_rays});
+  map_.Insert(rays, ToGlobal(local));
   stats_.front_end_s += Since(t0);
 
   if (nodes_since_solve_ >= options_.optimize_every_nodes) {
@@ -135,7 +137,6 @@ void GraphSlam::AddNode(const Pose2D& local, std::shared_ptr<const std::vector<S
                             options_.consecutive_rotation_weight, 0.0});
   }
   nodes_.push_back(std::move(n));
-  map_.Insert(*nodes_.back().rays, nodes_.back().global);
   ++nodes_since_solve_;
   ++stats_.nodes;
   if (submaps_[active_.front()].nodes >= 2 * options_.nodes_per_submap) {
@@ -187,7 +188,7 @@ std::unique_ptr<GraphSlam::Job> GraphSlam::MakeJob(int iterations, bool render) 
   for (const Submap& s : submaps_) job->submaps.push_back(s.global);
   job->constraints = constraints_;
   if (render) {
-    for (const Node& n : nodes_) job->rays.push_back(n.rays);
+    job->scans = scans_;
   }
   job->iterations = iterations;
   nodes_since_solve_ = 0;
@@ -215,10 +216,10 @@ void GraphSlam::RunJob(Job* job) const {
   PoseGraphOptions graph = options_.graph;
   graph.max_iterations = job->iterations;
   job->summary = OptimizePoseGraph(&job->nodes, &job->submaps, all, graph);
-  if (!job->rays.empty()) {
+  if (!job->scans.empty()) {
     t0 = Clock::now();
     LogOddsMapper map(map_options_);
-    for (size_t i = 0; i < job->rays.size(); ++i) map.Insert(*job->rays[i], job->nodes[i]);
+    for (const ScanAnchor& a : job->scans) map.Insert(*a.rays, job->nodes[a.node].Compose(a.relative));
     job->map = std::move(map);
     job->render_s = Since(t0);
   }
@@ -248,7 +249,9 @@ void GraphSlam::ApplyJob(Job* job) {
   stats_.loop_search_s += job->search_s;
   if (job->map) {
     map_ = std::move(*job->map);
-    for (size_t i = n_old; i < nodes_.size(); ++i) map_.Insert(*nodes_[i].rays, nodes_[i].global);
+    for (size_t i = job->scans.size(); i < scans_.size(); ++i) {
+      map_.Insert(*scans_[i].rays, nodes_[scans_[i].node].global.Compose(scans_[i].relative));
+    }
     stats_.render_s += job->render_s;
   }
 }
@@ -292,7 +295,7 @@ void GraphSlam::Finish() {
   ApplyJob(job.get());
   const auto t0 = Clock::now();
   LogOddsMapper map(map_options_);
-  for (const Node& n : nodes_) map.Insert(*n.rays, n.global);
+  for (const ScanAnchor& a : scans_) map.Insert(*a.rays, nodes_[a.node].global.Compose(a.relative));
   map_ = std::move(map);
   stats_.render_s += Since(t0);
 }

@@ -4,8 +4,9 @@
 // `nodes_per_submap` nodes; a back end that searches loop closures of nodes against finished
 // submaps (branch and bound over a large window, accepted by score, refined by Ceres) and optimises
 // the pose graph with Ceres every `optimize_every_nodes` nodes — on a worker thread when
-// `background`, so the front end publishes each scan's pose at once. The map is the scans rendered
-// at the optimised poses.
+// `background`, so the front end publishes each scan's pose at once. The map holds every scan: each
+// is added at its pose when it comes, and the whole map is rendered again from the optimised poses
+// after each solve (rerender_map) and at the end.
 #pragma once
 
 #include <condition_variable>
@@ -111,6 +112,11 @@ class GraphSlam {
   struct Search {
     int node = 0, submap = 0;
   };
+  struct ScanAnchor {
+    int node = 0;
+    motion::Pose2D relative;  // the scan's local pose in its node's local frame
+    std::shared_ptr<const std::vector<ScanRay>> rays;
+  };
   // What a solve needs, copied, and what it returns.
   struct Job {
     std::vector<Search> searches;
@@ -119,7 +125,7 @@ class GraphSlam {
     std::vector<motion::Pose2D> search_submap_local;
     std::vector<motion::Pose2D> nodes, submaps;
     std::vector<PoseConstraint> constraints;
-    std::vector<std::shared_ptr<const std::vector<ScanRay>>> rays;  // for the re-render
+    std::vector<ScanAnchor> scans;  // for the re-render (empty: none)
     int iterations = 50;
     // Out.
     std::vector<PoseConstraint> found;
@@ -151,10 +157,6 @@ class GraphSlam {
   std::vector<PoseConstraint> constraints_;
   std::vector<Search> pending_;
   int nodes_since_solve_ = 0;
-  struct ScanAnchor {
-    int node = 0;
-    motion::Pose2D relative;  // the scan's local pose in its node's local frame
-  };
   std::vector<ScanAnchor> scans_;
   LogOddsMapper map_;
   GraphSlamStats stats_;
