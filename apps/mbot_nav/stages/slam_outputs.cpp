@@ -68,7 +68,8 @@ std::string GraphJson(const mapping::GraphSlamStats& g) {
     << ", \"loop_searches\": " << g.loop_searches << ", \"loop_closures\": " << g.loop_closures
     << ", \"optimizations\": " << g.optimizations << ", \"front_end_s\": " << Num(g.front_end_s)
     << ", \"loop_search_s\": " << Num(g.loop_search_s) << ", \"optimize_s\": " << Num(g.optimize_s)
-    << ", \"render_s\": " << Num(g.render_s) << ", \"rejected_closures\": [";
+    << ", \"render_s\": " << Num(g.render_s) << ", \"apply_max_s\": " << Num(g.apply_max_s)
+    << ", \"rejected_closures\": [";
   for (size_t i = 0; i < g.rejected.size(); ++i) {
     const mapping::RejectedClosure& r = g.rejected[i];
     j << (i ? ", " : "") << "{\"node\": " << r.node << ", \"submap\": " << r.submap << ", \"score\": " << Num(r.score)

@@ -23,6 +23,14 @@ int LevelsFor(double linear_m, double resolution_m) {
 
 }  // namespace
 
+const MatchGrid& GraphSlam::LoopField::Get() const {
+  std::call_once(once_, [&] {
+    field_ = std::make_unique<const MatchGrid>(grid_, sigma_m_, threshold_, levels_);
+    grid_ = OccupancyGrid();
+  });
+  return *field_;
+}
+
 GraphSlam::GraphSlam(const GraphSlamOptions& options, const MapperOptions& map_options)
     : options_(options), map_options_(map_options), map_(map_options) {
   if (options.nodes_per_submap < 1) throw std::invalid_argument("graph SLAM: nodes_per_submap must be at least 1");
@@ -154,10 +162,11 @@ void GraphSlam::AddNode(const Pose2D& local, std::shared_ptr<const std::vector<S
 void GraphSlam::FinishSubmap(int index) {
   Submap& s = submaps_[index];
   // Cropped to what the submap saw: a finished submap keeps its levels for every later search.
-  s.field = std::make_shared<const MatchGrid>(
+  s.loop = std::make_shared<const LoopField>(
       CropToKnown(s.grid->map(), 0.5), options_.field_sigma_m, options_.occupied_threshold,
       std::min(options_.loop_levels, LevelsFor(options_.loop_window.linear_m, options_.submap.resolution_m)));
   s.grid.reset();
+  s.field.reset();
   s.finished = true;
   s.dirty = false;
   // The nodes before it may see it too (the robot came back to where it is now).
@@ -181,7 +190,7 @@ std::unique_ptr<GraphSlam::Job> GraphSlam::MakeJob(int iterations, bool render) 
   for (const Search& q : job->searches) {
     job->search_points.push_back(nodes_[q.node].points);
     job->search_loop_points.push_back(nodes_[q.node].loop_points);
-    job->search_fields.push_back(submaps_[q.submap].field);
+    job->search_fields.push_back(submaps_[q.submap].loop);
     job->search_submap_local.push_back(submaps_[q.submap].local);
   }
   for (const Node& n : nodes_) job->nodes.push_back(n.global);
@@ -202,11 +211,12 @@ void GraphSlam::RunJob(Job* job) const {
     const Pose2D& origin = job->search_submap_local[i];
     // The node's pose in the submap's grid, by the current estimate.
     const Pose2D guess = origin.Compose(job->submaps[q.submap].Inverse().Compose(job->nodes[q.node]));
-    const MatchResult m = MatchBranchAndBound(*job->search_fields[i], *job->search_loop_points[i], guess,
-                                              options_.loop_window, options_.loop_min_score);
+    const MatchGrid& field = job->search_fields[i]->Get();
+    const MatchResult m =
+        MatchBranchAndBound(field, *job->search_loop_points[i], guess, options_.loop_window, options_.loop_min_score);
     ++job->searched;
     if (!m.found) continue;
-    const Pose2D refined = RefineMatch(*job->search_fields[i], *job->search_points[i], m.pose, options_.refine);
+    const Pose2D refined = RefineMatch(field, *job->search_points[i], m.pose, options_.refine);
     job->found.push_back({PoseConstraint::kLoopClosure, q.submap, q.node, origin.Inverse().Compose(refined),
                           options_.loop_translation_weight, options_.loop_rotation_weight, m.score});
   }
@@ -226,6 +236,7 @@ void GraphSlam::RunJob(Job* job) const {
 }
 
 void GraphSlam::ApplyJob(Job* job) {
+  const auto t0 = Clock::now();
   const size_t n_old = job->nodes.size(), s_old = job->submaps.size();
   if (n_old > 0) {
     for (size_t i = 0; i < n_old; ++i) nodes_[i].global = job->nodes[i];
@@ -254,6 +265,7 @@ void GraphSlam::ApplyJob(Job* job) {
     }
     stats_.render_s += job->render_s;
   }
+  stats_.apply_max_s = std::max(stats_.apply_max_s, Since(t0));
 }
 
 void GraphSlam::MaybeApplyFinished() {

@@ -71,6 +71,9 @@ struct GraphSlamStats {
   std::vector<RejectedClosure> rejected;  // by the robust loss, at the last solve
   int optimizations = 0;
   double optimize_s = 0, loop_search_s = 0, front_end_s = 0, render_s = 0;
+  // The longest a solve's result took to take in on the front end's thread (it adds the scans that
+  // came in meanwhile to the re-rendered map).
+  double apply_max_s = 0;
 };
 
 class GraphSlam {
@@ -101,10 +104,26 @@ class GraphSlam {
     std::shared_ptr<const std::vector<Point2>> points, loop_points;
     std::vector<int> submaps;  // it was inserted into
   };
+  // A finished submap's search field, built on its first search (on the worker when `background`),
+  // so finishing a submap costs the front end only a crop of its grid.
+  class LoopField {
+   public:
+    LoopField(OccupancyGrid grid, double sigma_m, int occupied_threshold, int levels)
+        : grid_(std::move(grid)), sigma_m_(sigma_m), threshold_(occupied_threshold), levels_(levels) {}
+    const MatchGrid& Get() const;
+
+   private:
+    mutable OccupancyGrid grid_;  // released once the field is built
+    double sigma_m_;
+    int threshold_, levels_;
+    mutable std::once_flag once_;
+    mutable std::unique_ptr<const MatchGrid> field_;
+  };
   struct Submap {
     motion::Pose2D local, global;            // local: a translation (the grid is axis-aligned in the local frame)
     std::unique_ptr<LogOddsMapper> grid;     // while active
-    std::shared_ptr<const MatchGrid> field;  // for matching (finished: with loop_levels)
+    std::shared_ptr<const MatchGrid> field;  // the front end's (while active)
+    std::shared_ptr<const LoopField> loop;   // the loop-closure search's (once finished)
     bool dirty = true;
     bool finished = false;
     int nodes = 0;
@@ -121,7 +140,7 @@ class GraphSlam {
   struct Job {
     std::vector<Search> searches;
     std::vector<std::shared_ptr<const std::vector<Point2>>> search_points, search_loop_points;
-    std::vector<std::shared_ptr<const MatchGrid>> search_fields;
+    std::vector<std::shared_ptr<const LoopField>> search_fields;
     std::vector<motion::Pose2D> search_submap_local;
     std::vector<motion::Pose2D> nodes, submaps;
     std::vector<PoseConstraint> constraints;
