@@ -91,7 +91,7 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
         std::hypot(moved.x, moved.y) >= options_.node_distance_m || std::abs(moved.theta) >= options_.node_angle_rad;
   }
   auto shared_rays = std::make_shared<const std::vector<ScanRay>>(rays);
-  if (make_node) AddNode(local, shared_rays, points);
+  if (make_node) AddNode(local, odometry, shared_rays, points);
   scans_.push_back({static_cast<int>(nodes_.size()) - 1, nodes_.back().local.Inverse().Compose(local), shared_rays});
   map_.Insert(rays, ToGlobal(local));
   stats_.front_end_s += Since(t0);
@@ -113,11 +113,11 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
   return ToGlobal(local);
 }
 
-void GraphSlam::AddNode(const Pose2D& local, std::shared_ptr<const std::vector<ScanRay>> rays,
+void GraphSlam::AddNode(const Pose2D& local, const Pose2D& odometry, std::shared_ptr<const std::vector<ScanRay>> rays,
                         std::shared_ptr<const std::vector<Point2>> points) {
   const int index = static_cast<int>(nodes_.size());
   auto loop_points = std::make_shared<const std::vector<Point2>>(ScanHitPoints(*rays, options_.loop_point_spacing_m));
-  Node n{local, ToGlobal(local), std::move(rays), std::move(points), std::move(loop_points), {}};
+  Node n{local, ToGlobal(local), odometry, std::move(rays), std::move(points), std::move(loop_points), {}};
   if (active_.empty() || submaps_[active_.back()].nodes >= options_.nodes_per_submap) {
     Submap s;
     s.local = {local.x, local.y, 0.0};
@@ -143,6 +143,11 @@ void GraphSlam::AddNode(const Pose2D& local, std::shared_ptr<const std::vector<S
     constraints_.push_back({PoseConstraint::kConsecutive, index - 1, index,
                             nodes_[index - 1].local.Inverse().Compose(local), options_.consecutive_translation_weight,
                             options_.consecutive_rotation_weight, 0.0});
+    if (options_.odometry_translation_weight > 0 || options_.odometry_rotation_weight > 0) {
+      constraints_.push_back({PoseConstraint::kOdometry, index - 1, index,
+                              nodes_[index - 1].odometry.Inverse().Compose(odometry),
+                              options_.odometry_translation_weight, options_.odometry_rotation_weight, 0.0});
+    }
   }
   nodes_.push_back(std::move(n));
   ++nodes_since_solve_;

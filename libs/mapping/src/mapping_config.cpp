@@ -183,6 +183,11 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
       num("loop_translation_weight", g.loop_translation_weight, "weight of a loop closure's position", 0.0, 1e12);
   g.loop_rotation_weight =
       num("loop_rotation_weight", g.loop_rotation_weight, "weight of a loop closure's heading", 0.0, 1e12);
+  g.odometry_translation_weight =
+      num("odometry_translation_weight", g.odometry_translation_weight,
+          "weight of consecutive nodes' relative position by odometry (0: none)", 0.0, 1e12);
+  g.odometry_rotation_weight = num("odometry_rotation_weight", g.odometry_rotation_weight,
+                                   "weight of consecutive nodes' relative heading by odometry (0: none)", 0.0, 1e12);
   g.loop_window.linear_m = num("loop_window_m", g.loop_window.linear_m, "loop closure: search window, +-", 0.0, 100.0);
   g.loop_window.angular_rad =
       num("loop_window_rad", g.loop_window.angular_rad, "loop closure: angular search window, +-", 0.0, M_PI);

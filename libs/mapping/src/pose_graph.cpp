@@ -41,7 +41,7 @@ struct RelativePoseCost {
 
 double ConstraintResidual(const PoseConstraint& c, const std::vector<motion::Pose2D>& nodes,
                           const std::vector<motion::Pose2D>& submaps) {
-  const motion::Pose2D& a = c.kind == PoseConstraint::kConsecutive ? nodes[c.from] : submaps[c.from];
+  const motion::Pose2D& a = BetweenNodes(c) ? nodes[c.from] : submaps[c.from];
   const motion::Pose2D& b = nodes[c.to];
   const double pa[3] = {a.x, a.y, a.theta}, pb[3] = {b.x, b.y, b.theta};
   double r[3];
@@ -61,7 +61,7 @@ PoseGraphSummary OptimizePoseGraph(std::vector<motion::Pose2D>* nodes, std::vect
     s[3 * i] = (*submaps)[i].x, s[3 * i + 1] = (*submaps)[i].y, s[3 * i + 2] = (*submaps)[i].theta;
   ceres::Problem problem;
   for (const PoseConstraint& c : constraints) {
-    double* a = c.kind == PoseConstraint::kConsecutive ? &n[3 * c.from] : &s[3 * c.from];
+    double* a = BetweenNodes(c) ? &n[3 * c.from] : &s[3 * c.from];
     double* b = &n[3 * c.to];
     ceres::LossFunction* loss =
         c.kind == PoseConstraint::kLoopClosure ? new ceres::HuberLoss(options.huber_scale) : nullptr;

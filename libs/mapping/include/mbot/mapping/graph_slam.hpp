@@ -47,6 +47,8 @@ struct GraphSlamOptions {
   double local_translation_weight = 1e5, local_rotation_weight = 1e5;
   double consecutive_translation_weight = 1e5, consecutive_rotation_weight = 1e5;
   double loop_translation_weight = 1.1e4, loop_rotation_weight = 1e5;
+  // Consecutive nodes' relative motion by odometry (0: no odometry constraints).
+  double odometry_translation_weight = 1e3, odometry_rotation_weight = 1e3;
   // Loop closure.
   SearchWindow loop_window{3.0, 0.35, 0.005};
   double loop_min_score = 0.55;
@@ -100,6 +102,7 @@ class GraphSlam {
  private:
   struct Node {
     motion::Pose2D local, global;
+    motion::Pose2D odometry;  // the odometry reading at the node's scan
     std::shared_ptr<const std::vector<ScanRay>> rays;
     std::shared_ptr<const std::vector<Point2>> points, loop_points;
     std::vector<int> submaps;  // it was inserted into
@@ -154,8 +157,8 @@ class GraphSlam {
     std::optional<LogOddsMapper> map;
   };
 
-  void AddNode(const motion::Pose2D& local, std::shared_ptr<const std::vector<ScanRay>> rays,
-               std::shared_ptr<const std::vector<Point2>> points);
+  void AddNode(const motion::Pose2D& local, const motion::Pose2D& odometry,
+               std::shared_ptr<const std::vector<ScanRay>> rays, std::shared_ptr<const std::vector<Point2>> points);
   void FinishSubmap(int index);
   void QueueSearches(int node, int submap);
   std::unique_ptr<Job> MakeJob(int iterations, bool render);
