@@ -17,8 +17,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <iterator>
+#include <map>
 #include <memory>
 #include <random>
 #include <string>
@@ -408,6 +410,57 @@ BENCHMARK(BM_ParticleFilter_MRPT)
 BENCHMARK(BM_MapUpdate_LogOdds)->UseRealTime()->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_LookupBound)->Apply(MrptArgs)->ArgNames({"particles"})->UseRealTime()->Unit(benchmark::kMicrosecond);
 
+// Prints, after the usual table, the ratios the performance targets are stated in, from the runs of
+// this same invocation (medians when --benchmark_repetitions is given): our whole update on one
+// thread against the lookup loop's bound, and MRPT's update against ours on one thread.
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& r : runs) {
+      if (r.run_type == Run::RT_Iteration && !r.error_occurred)
+        times_[r.benchmark_name()].push_back(r.GetAdjustedRealTime());
+    }
+    ConsoleReporter::ReportRuns(runs);
+  }
+  void Finalize() override {
+    ConsoleReporter::Finalize();
+    bool header = false;
+    for (int64_t n : kParticleCounts) {
+      const std::string p = "particles:" + std::to_string(n);
+      const double ours = Median("BM_ParticleFilter_Ours/" + p + "/threads:1/real_time");
+      const double bound = Median("BM_LookupBound/" + p + "/real_time");
+      const double mrpt = Median("BM_ParticleFilter_MRPT/" + p + "/real_time");
+      if (!(ours > 0) || (!(bound > 0) && !(mrpt > 0))) continue;
+      if (!header) {
+        std::printf("\n%-10s %14s %14s %14s %12s %12s\n", "particles", "ours 1 thread", "lookup bound", "MRPT",
+                    "ours/bound", "MRPT/ours");
+        header = true;
+      }
+      auto cell = [](double v) { return v > 0 ? v : NAN; };
+      std::printf("%-10lld %14.1f %14.1f %14.1f %12.2f %12.1f\n", static_cast<long long>(n), ours, cell(bound),
+                  cell(mrpt), cell(bound) > 0 ? ours / bound : NAN, cell(mrpt) > 0 ? mrpt / ours : NAN);
+    }
+    if (header) std::printf("(real time per update, us; ratios from this run)\n");
+  }
+
+ private:
+  double Median(const std::string& name) const {
+    auto it = times_.find(name);
+    if (it == times_.end() || it->second.empty()) return 0.0;
+    std::vector<double> v = it->second;
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  }
+  std::map<std::string, std::vector<double>> times_;
+};
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  benchmark::Shutdown();
+  return 0;
+}
