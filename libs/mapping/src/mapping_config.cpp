@@ -228,7 +228,9 @@ SlamOptions ParseSlamOptions(config::Section& s) {
   m.action = ParseActionModelOptions(s);
   m.sensor = ParseSensorModelOptions(s);
   m.filter = ParseParticleFilterOptions(s, m.mode);
-  if (m.mode == SlamMode::kGraphSlam) m.graph = ParseGraphSlamOptions(s);
+  // The graph keys exist in graph_slam mode only (elsewhere they are unknown keys); --list-stages
+  // documents them too.
+  if (m.mode == SlamMode::kGraphSlam || s.describing()) m.graph = ParseGraphSlamOptions(s);
   return m;
 }
 
