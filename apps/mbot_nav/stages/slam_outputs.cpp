@@ -2,15 +2,14 @@
 
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <sstream>
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/drivers/map_io.hpp"
-#include "mbot/motion/relations.hpp"
 #include "mbot/motion/trajectory_error.hpp"
 #include "report.hpp"
+#include "slam_graph_report.hpp"
 
 namespace mbot::app {
 namespace {
@@ -37,46 +36,6 @@ void WriteScansCsv(const std::string& path, const std::vector<ScanRecord>& recor
       o << line;
     }
   });
-}
-
-std::string MeanStdJson(const motion::MeanStd& m) {
-  return "{\"mean\": " + Num(m.mean) + ", \"std\": " + Num(m.std) + "}";
-}
-
-// The Kuemmerle et al. relations metric on the run's trajectory (throws RelationsError naming the
-// file and the first stamp without a pose).
-std::string RelationsJson(const std::string& path, const std::vector<TimedPose>& path_poses) {
-  std::map<int64_t, Pose2D> poses;
-  for (const TimedPose& p : path_poses) poses.emplace(p.t_us, p.pose);
-  const motion::RelationErrors e = motion::ScoreRelations(motion::ReadRelations(path), poses, path);
-  mbot::log::Info("slam: relations (" + path + ", " + std::to_string(e.scored) + " of " + std::to_string(e.relations) +
-                  " scored): translation " + Num(e.trans_m.mean, 4) + " +- " + Num(e.trans_m.std, 4) + " m, rotation " +
-                  Num(e.rot_deg.mean, 3) + " +- " + Num(e.rot_deg.std, 3) + " deg");
-  std::ostringstream j;
-  j << "{\"file\": " << JsonString(path) << ", \"relations\": " << e.relations << ", \"scored\": " << e.scored
-    << ", \"translation_m\": " << MeanStdJson(e.trans_m) << ", \"rotation_deg\": " << MeanStdJson(e.rot_deg)
-    << ", \"translation_sq_m2\": " << MeanStdJson(e.trans_sq_m2)
-    << ", \"rotation_sq_deg2\": " << MeanStdJson(e.rot_sq_deg2) << ", \"max_translation_m\": " << Num(e.max_trans_m)
-    << ", \"max_rotation_deg\": " << Num(e.max_rot_deg) << "}";
-  return j.str();
-}
-
-// What graph SLAM did: its graph, its loop closures (those the robust loss rejected, listed), its time.
-std::string GraphJson(const mapping::GraphSlamStats& g) {
-  std::ostringstream j;
-  j << "{\"nodes\": " << g.nodes << ", \"submaps\": " << g.submaps << ", \"sparse_scans\": " << g.sparse_scans
-    << ", \"loop_searches\": " << g.loop_searches << ", \"loop_closures\": " << g.loop_closures
-    << ", \"optimizations\": " << g.optimizations << ", \"front_end_s\": " << Num(g.front_end_s)
-    << ", \"loop_search_s\": " << Num(g.loop_search_s) << ", \"optimize_s\": " << Num(g.optimize_s)
-    << ", \"render_s\": " << Num(g.render_s) << ", \"apply_max_s\": " << Num(g.apply_max_s)
-    << ", \"rejected_closures\": [";
-  for (size_t i = 0; i < g.rejected.size(); ++i) {
-    const mapping::RejectedClosure& r = g.rejected[i];
-    j << (i ? ", " : "") << "{\"node\": " << r.node << ", \"submap\": " << r.submap << ", \"score\": " << Num(r.score)
-      << ", \"residual\": " << Num(r.residual) << "}";
-  }
-  j << "]}";
-  return j.str();
 }
 
 }  // namespace
@@ -192,31 +151,11 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& ru
                     Num(a.theta.rmse * 180 / M_PI, 3) + " deg; odometry xy " + Num(o.xy.rmse, 3) + " m, theta " +
                     Num(o.theta.rmse * 180 / M_PI, 3) + " deg");
   }
-  if (const mapping::GraphSlam* g = run.slam->graph()) {
-    const mapping::GraphSlamStats& st = g->stats();
-    j << ",\n  \"graph\": " << GraphJson(st);
-    mbot::log::Info("slam: graph of " + std::to_string(st.nodes) + " nodes in " + std::to_string(st.submaps) +
-                    " submaps; " + std::to_string(st.loop_closures) + " loop closures from " +
-                    std::to_string(st.loop_searches) + " searches, " + std::to_string(st.rejected.size()) +
-                    " rejected by the robust loss; " + std::to_string(st.sparse_scans) + " scans too sparse to match");
-    for (size_t i = 0; i < st.rejected.size() && i < 5; ++i) {
-      const mapping::RejectedClosure& r = st.rejected[i];
-      mbot::log::Warn(
-          "slam: loop closure of node " + std::to_string(r.node) + " to submap " + std::to_string(r.submap) +
-          " (score " + Num(r.score, 3) + ") rejected by the robust loss (residual " + Num(r.residual, 3) + ")" +
-          (i == 4 && st.rejected.size() > 5 ? "; metrics.json lists all " + std::to_string(st.rejected.size()) : ""));
-    }
-  }
+  if (const mapping::GraphSlam* g = run.slam->graph()) j << ",\n  \"graph\": " << GraphSlamJson(g->stats());
   // A relations file that does not fit the run is an error, but only once everything else is written.
   std::string relations_error;
-  if (!options.relations_file.empty()) {
-    try {
-      j << ",\n  \"relations\": " << RelationsJson(options.relations_file, slam_path);
-    } catch (const motion::RelationsError& e) {
-      relations_error = e.what();
-      j << ",\n  \"relations\": {\"error\": " << JsonString(relations_error) << "}";
-    }
-  }
+  if (!options.relations_file.empty())
+    j << ",\n  \"relations\": " << RelationsJson(options.relations_file, slam_path, &relations_error);
   const mapping::SlamEventTracker& ev = *run.events;
   j << ",\n  \"global_localization\": ";
   if (!ev.global()) {

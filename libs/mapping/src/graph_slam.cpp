@@ -226,16 +226,18 @@ void GraphSlam::RunJob(Job* job) const {
                           options_.loop_translation_weight, options_.loop_rotation_weight, m.score});
   }
   job->search_s = Since(t0);
-  std::vector<PoseConstraint> all = job->constraints;
-  all.insert(all.end(), job->found.begin(), job->found.end());
+  job->constraints.insert(job->constraints.end(), job->found.begin(), job->found.end());
   PoseGraphOptions graph = options_.graph;
   graph.max_iterations = job->iterations;
-  job->summary = OptimizePoseGraph(&job->nodes, &job->submaps, all, graph);
+  job->summary = OptimizePoseGraph(&job->nodes, &job->submaps, job->constraints, graph);
+  for (int idx : job->summary.rejected) {
+    const PoseConstraint& c = job->constraints[idx];
+    job->rejected.push_back({c.to, c.from, c.score, ConstraintResidual(c, job->nodes, job->submaps)});
+  }
   if (!job->scans.empty()) {
     t0 = Clock::now();
-    LogOddsMapper map(map_options_);
-    for (const ScanAnchor& a : job->scans) map.Insert(*a.rays, job->nodes[a.node].Compose(a.relative));
-    job->map = std::move(map);
+    job->map.emplace(map_options_);
+    InsertScans(job->scans, 0, job->nodes, &*job->map);
     job->render_s = Since(t0);
   }
 }
@@ -250,13 +252,7 @@ void GraphSlam::ApplyJob(Job* job) {
     for (size_t i = n_old; i < nodes_.size(); ++i) nodes_[i].global = ToGlobal(nodes_[i].local);
     for (size_t i = s_old; i < submaps_.size(); ++i) submaps_[i].global = ToGlobal(submaps_[i].local);
   }
-  stats_.rejected.clear();
-  std::vector<PoseConstraint> all = job->constraints;
-  all.insert(all.end(), job->found.begin(), job->found.end());
-  for (int idx : job->summary.rejected) {
-    const PoseConstraint& c = all[idx];
-    stats_.rejected.push_back({c.to, c.from, c.score, ConstraintResidual(c, job->nodes, job->submaps)});
-  }
+  stats_.rejected = std::move(job->rejected);
   constraints_.insert(constraints_.end(), job->found.begin(), job->found.end());
   stats_.loop_searches += job->searched;
   stats_.loop_closures += static_cast<int64_t>(job->found.size());
@@ -265,9 +261,7 @@ void GraphSlam::ApplyJob(Job* job) {
   stats_.loop_search_s += job->search_s;
   if (job->map) {
     map_ = std::move(*job->map);
-    for (size_t i = job->scans.size(); i < scans_.size(); ++i) {
-      map_.Insert(*scans_[i].rays, nodes_[scans_[i].node].global.Compose(scans_[i].relative));
-    }
+    InsertScans(scans_, job->scans.size(), NodePoses(), &map_);
     stats_.render_s += job->render_s;
   }
   stats_.apply_max_s = std::max(stats_.apply_max_s, Since(t0));
@@ -311,10 +305,22 @@ void GraphSlam::Finish() {
   RunJob(job.get());
   ApplyJob(job.get());
   const auto t0 = Clock::now();
-  LogOddsMapper map(map_options_);
-  for (const ScanAnchor& a : scans_) map.Insert(*a.rays, nodes_[a.node].global.Compose(a.relative));
-  map_ = std::move(map);
+  map_ = LogOddsMapper(map_options_);
+  InsertScans(scans_, 0, NodePoses(), &map_);
   stats_.render_s += Since(t0);
+}
+
+void GraphSlam::InsertScans(const std::vector<ScanAnchor>& scans, size_t from, const std::vector<Pose2D>& nodes,
+                            LogOddsMapper* map) {
+  for (size_t i = from; i < scans.size(); ++i)
+    map->Insert(*scans[i].rays, nodes[scans[i].node].Compose(scans[i].relative));
+}
+
+std::vector<Pose2D> GraphSlam::NodePoses() const {
+  std::vector<Pose2D> out;
+  out.reserve(nodes_.size());
+  for (const Node& n : nodes_) out.push_back(n.global);
+  return out;
 }
 
 std::vector<Pose2D> GraphSlam::Trajectory() const {

@@ -114,6 +114,8 @@ struct Candidate {
   int64_t score = 0;
 };
 
+bool BestFirst(const Candidate& a, const Candidate& b) { return a.score > b.score; }
+
 class BranchAndBound {
  public:
   BranchAndBound(const MatchGrid& grid, const std::vector<std::vector<int>>& cells, int window_cells)
@@ -146,8 +148,7 @@ class BranchAndBound {
           children.push_back(child);
         }
       }
-      std::sort(children.begin(), children.end(),
-                [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+      std::sort(children.begin(), children.end(), BestFirst);
       Search(children, h - 1);
     }
   }
@@ -200,8 +201,7 @@ MatchResult MatchBranchAndBound(const MatchGrid& grid, const std::vector<Point2>
       }
     }
   }
-  std::sort(candidates.begin(), candidates.end(),
-            [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  std::sort(candidates.begin(), candidates.end(), BestFirst);
   // Scores are sums of 8-bit field values: the bar is min_score of the most the points can sum to.
   bb.best_.score = static_cast<int64_t>(std::ceil(min_score * 255.0 * points.size())) - 1;
   bb.Search(candidates, top);

@@ -146,12 +146,13 @@ class GraphSlam {
     std::vector<std::shared_ptr<const LoopField>> search_fields;
     std::vector<motion::Pose2D> search_submap_local;
     std::vector<motion::Pose2D> nodes, submaps;
-    std::vector<PoseConstraint> constraints;
-    std::vector<ScanAnchor> scans;  // for the re-render (empty: none)
+    std::vector<PoseConstraint> constraints;  // the found loop closures are appended
+    std::vector<ScanAnchor> scans;            // for the re-render (empty: none)
     int iterations = 50;
     // Out.
     std::vector<PoseConstraint> found;
     PoseGraphSummary summary;
+    std::vector<RejectedClosure> rejected;
     int64_t searched = 0;
     double search_s = 0, render_s = 0;
     std::optional<LogOddsMapper> map;
@@ -166,6 +167,10 @@ class GraphSlam {
   void ApplyJob(Job* job);
   void MaybeApplyFinished();
   void WorkerLoop();
+  // Adds scans[from..] to `map` at their nodes' poses.
+  static void InsertScans(const std::vector<ScanAnchor>& scans, size_t from, const std::vector<motion::Pose2D>& nodes,
+                          LogOddsMapper* map);
+  std::vector<motion::Pose2D> NodePoses() const;
   motion::Pose2D ToGlobal(const motion::Pose2D& local) const { return correction_.Compose(local); }
 
   GraphSlamOptions options_;
