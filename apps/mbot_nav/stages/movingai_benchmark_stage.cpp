@@ -26,6 +26,8 @@ struct MovingAiBenchmarkOptions {
   double tolerance = 0.01;      // |length - optimal| allowed
   bool require_optimal = true;  // fail the run when a scenario is not solved optimally
   int sample_every = 1;         // run scenarios whose index is a multiple of this (1: all)
+  planning::SearchAlgorithm search = planning::SearchAlgorithm::kAuto;
+  bool compare_astar = false;  // also run A* on every scenario: its times, its optimality, the speed-up
 };
 
 struct Row {
@@ -33,14 +35,20 @@ struct Row {
   bool found = false;
   double length = 0.0, optimal = 0.0, time_us = 0.0;
   int64_t expansions = 0;
+  double astar_length = 0.0, astar_time_us = 0.0;  // with compare_astar
+  bool astar_found = false;
 };
 
 class MovingAiBenchmarkStage : public Stage {
  public:
-  explicit MovingAiBenchmarkStage(MovingAiBenchmarkOptions o) : options_(std::move(o)), planner_(PlannerOptions()) {}
+  explicit MovingAiBenchmarkStage(MovingAiBenchmarkOptions o)
+      : options_(std::move(o)),
+        planner_(PlannerOptions(options_.search)),
+        astar_(PlannerOptions(planning::SearchAlgorithm::kAStar)) {}
 
-  static planning::AStarOptions PlannerOptions() {
+  static planning::AStarOptions PlannerOptions(planning::SearchAlgorithm search) {
     planning::AStarOptions a;
+    a.search = search;
     a.robot_radius_m = 0.0;
     a.ease_start_m = 0.0;
     a.ease_max_m = 0.0;
@@ -55,7 +63,9 @@ class MovingAiBenchmarkStage : public Stage {
       const auto& grid = std::get<std::shared_ptr<const mapping::OccupancyGrid>>(ev.payload);
       if (grid->resolution() != 1.0)
         throw std::runtime_error("movingai_benchmark: map '" + ev.channel + "' is not a Moving AI map");
-      planner_.SetMap(planning::ObstacleDistanceGrid(*grid, {}));
+      const planning::ObstacleDistanceGrid distances(*grid, {});
+      planner_.SetMap(distances);
+      if (options_.compare_astar) astar_.SetMap(distances);
       return;
     }
     if (ev.kind != drivers::EventKind::kPlanRequest) return;
@@ -72,54 +82,88 @@ class MovingAiBenchmarkStage : public Stage {
     row.length = r.length_m;  // 1 m cells: metres = cells
     row.optimal = req.optimal_length_m;
     row.expansions = r.expansions;
+    if (options_.compare_astar) {
+      const auto t1 = Clock::now();
+      const planning::PlanResult a = astar_.Plan(req.start, req.goal);
+      row.astar_time_us = std::chrono::duration<double, std::micro>(Clock::now() - t1).count();
+      row.astar_found = a.status == planning::PlanStatus::kFound;
+      row.astar_length = a.length_m;
+    }
     rows_.push_back(row);
   }
 
   void Finish(const RunContext& ctx, bool interrupted) override {
-    std::vector<double> times;
-    int optimal = 0, found = 0;
+    const bool compare = options_.compare_astar;
+    std::vector<double> times, astar_times;
+    int optimal = 0, found = 0, astar_optimal = 0;
     int64_t expansions = 0;
     double total_us = 0.0;
     std::vector<const Row*> wrong;
+    auto is_optimal = [&](bool ok, double length, double best) {
+      return ok && std::abs(length - best) <= options_.tolerance;
+    };
     for (const Row& r : rows_) {
       times.push_back(r.time_us);
       total_us += r.time_us;
       expansions += r.expansions;
       found += r.found;
-      if (r.found && std::abs(r.length - r.optimal) <= options_.tolerance)
-        ++optimal;
-      else
-        wrong.push_back(&r);
+      const bool ours = is_optimal(r.found, r.length, r.optimal);
+      const bool astar = !compare || is_optimal(r.astar_found, r.astar_length, r.optimal);
+      optimal += ours;
+      if (compare) {
+        astar_times.push_back(r.astar_time_us);
+        astar_optimal += astar;
+      }
+      if (!ours || !astar) wrong.push_back(&r);
     }
     const std::string csv = ctx.output_dir + "/" + options_.csv_file;
     WriteFileAtomically(csv, [&](std::ostream& out) {
-      out << "index,bucket,found,length,optimal,expansions,time_us\n";
-      char line[160];
+      out << "index,bucket,found,length,optimal,expansions,time_us" << (compare ? ",astar_length,astar_time_us" : "")
+          << "\n";
+      char line[200];
       for (const Row& r : rows_) {
-        std::snprintf(line, sizeof line, "%d,%d,%d,%.6f,%.6f,%lld,%.3f\n", r.index, r.bucket, r.found ? 1 : 0, r.length,
+        std::snprintf(line, sizeof line, "%d,%d,%d,%.6f,%.6f,%lld,%.3f", r.index, r.bucket, r.found ? 1 : 0, r.length,
                       r.optimal, static_cast<long long>(r.expansions), r.time_us);
         out << line;
+        if (compare) {
+          std::snprintf(line, sizeof line, ",%.6f,%.3f", r.astar_found ? r.astar_length : -1.0, r.astar_time_us);
+          out << line;
+        }
+        out << "\n";
       }
     });
     const SampleStats t = SampleStats::Of(times);
     const double rate = total_us > 0 ? expansions / (total_us * 1e-6) : 0.0;
+    const char* search = planner_.UsesJumpPoints() ? "jps" : "astar";
     char buf[512];
     std::snprintf(buf, sizeof buf,
-                  "%s: %zu problems, %d found, %d optimal within %.2g; time per query mean %.1f us, median %.1f us, "
-                  "max %.1f us; %.2f M expansions/s\n",
-                  map_name_.c_str(), rows_.size(), found, optimal, options_.tolerance, t.mean, t.median, t.max,
+                  "%s (%s): %zu problems, %d found, %d optimal within %.2g; time per query mean %.1f us, median %.1f "
+                  "us, max %.1f us; %.2f M expansions/s\n",
+                  map_name_.c_str(), search, rows_.size(), found, optimal, options_.tolerance, t.mean, t.median, t.max,
                   rate * 1e-6);
     std::cout << buf;
+    const SampleStats a = SampleStats::Of(astar_times);
+    if (compare) {
+      std::snprintf(buf, sizeof buf,
+                    "  A* on the same queries: %d optimal; mean %.1f us, median %.1f us; speed-up of the mean %.2fx\n",
+                    astar_optimal, a.mean, a.median, t.mean > 0 ? a.mean / t.mean : 0.0);
+      std::cout << buf;
+    }
     for (size_t i = 0; i < wrong.size() && i < 10; ++i) {
-      std::printf("  scenario %d: found %d, length %.4f, optimal %.4f\n", wrong[i]->index, wrong[i]->found,
-                  wrong[i]->length, wrong[i]->optimal);
+      std::printf("  scenario %d: found %d, length %.4f, optimal %.4f%s\n", wrong[i]->index, wrong[i]->found,
+                  wrong[i]->length, wrong[i]->optimal,
+                  compare ? (" (A* " + std::to_string(wrong[i]->astar_length) + ")").c_str() : "");
     }
     WriteFileAtomically(ctx.output_dir + "/" + options_.json_file, [&](std::ostream& out) {
-      out << "{\"map\": " << JsonString(map_name_) << ", \"problems\": " << rows_.size() << ", \"found\": " << found
-          << ", \"optimal\": " << optimal << ", \"tolerance\": " << Num(options_.tolerance)
-          << ", \"time_us\": " << t.Json() << ", \"expansions\": " << expansions
-          << ", \"expansions_per_s\": " << Num(rate) << ", \"interrupted\": " << (interrupted ? "true" : "false")
-          << "}\n";
+      out << "{\"map\": " << JsonString(map_name_) << ", \"search\": \"" << search
+          << "\", \"problems\": " << rows_.size() << ", \"found\": " << found << ", \"optimal\": " << optimal
+          << ", \"tolerance\": " << Num(options_.tolerance) << ", \"time_us\": " << t.Json()
+          << ", \"expansions\": " << expansions << ", \"expansions_per_s\": " << Num(rate);
+      if (compare) {
+        out << ", \"astar\": {\"optimal\": " << astar_optimal << ", \"time_us\": " << a.Json()
+            << ", \"speedup_of_mean\": " << Num(t.mean > 0 ? a.mean / t.mean : 0.0) << "}";
+      }
+      out << ", \"interrupted\": " << (interrupted ? "true" : "false") << "}\n";
     });
     mbot::log::Info("wrote " + csv);
     if (options_.require_optimal && !wrong.empty() && !interrupted) {
@@ -130,7 +174,7 @@ class MovingAiBenchmarkStage : public Stage {
 
  private:
   MovingAiBenchmarkOptions options_;
-  planning::AStarPlanner planner_;
+  planning::AStarPlanner planner_, astar_;
   std::string map_name_;
   std::vector<Row> rows_;
 };
@@ -153,6 +197,13 @@ StageType MovingAiBenchmarkStageType() {
                                           "run only scenarios whose index is a multiple of this (1: every one; "
                                           "the default ctest run samples, the movingai_full label runs all)",
                                           1, 1000000));
+            const std::string search = s.GetChoice("search", "auto", {"auto", "astar", "jps"},
+                                                   "planner search: auto picks jump point search (uniform costs)");
+            o.search = search == "astar" ? planning::SearchAlgorithm::kAStar
+                       : search == "jps" ? planning::SearchAlgorithm::kJumpPoint
+                                         : planning::SearchAlgorithm::kAuto;
+            o.compare_astar = s.GetBool("compare_astar", o.compare_astar,
+                                        "also run A* on every scenario: its optimality, times and the speed-up");
             return std::make_unique<MovingAiBenchmarkStage>(o);
           }};
 }

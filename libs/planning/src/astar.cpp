@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <limits>
+#include <optional>
 #include <stdexcept>
+
+#include "jump_point_search.hpp"
 
 namespace mbot::planning {
 namespace {
@@ -12,17 +14,8 @@ namespace {
 constexpr double kSqrt2 = 1.4142135623730951;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// 16 bytes: f, the node, and g (as float, only to break ties).
-struct HeapEntry {
-  double f;
-  int32_t index;
-  float g;
-};
-// Smallest f first; among equal f the deeper node (larger g) first, which keeps A* from fanning
-// out over the many equal-cost paths of an open grid.
-struct HeapOrder {
-  bool operator()(const HeapEntry& a, const HeapEntry& b) const { return a.f > b.f || (a.f == b.f && a.g < b.g); }
-};
+using detail::HeapEntry;
+using detail::HeapOrder;
 
 }  // namespace
 
@@ -50,13 +43,10 @@ struct AStarPlanner::Impl {
   int offsets[8];
   double step_len[8];
 
-  struct Node {
-    double g;
-    int32_t parent;
-    uint32_t mark;  // 2·generation: open (g valid); 2·generation + 1: closed
-  };
+  using Node = detail::SearchNode;
   std::vector<Node> nodes;
   uint32_t generation = 0;
+  detail::SearchMarks jps_marks;
   std::vector<HeapEntry> heap;
   std::vector<int> fast;
 
@@ -67,6 +57,16 @@ struct AStarPlanner::Impl {
     std::vector<int32_t> label;  // padded; -1 where not passable
   };
   std::vector<Components> components;
+  // Passable cells as bit rows per clearance, for jump point search; built on first use.
+  std::vector<std::unique_ptr<detail::PassableBits>> passable;
+
+  const detail::PassableBits& PassableAt(float clearance) {
+    for (const auto& p : passable) {
+      if (p->clearance() == clearance) return *p;
+    }
+    passable.push_back(std::make_unique<detail::PassableBits>(dist, stride, rows, clearance));
+    return *passable.back();
+  }
 
   int Index(int cx, int cy) const { return (cy + 1) * stride + (cx + 1); }
   void CellOf(int index, int* cx, int* cy) const {
@@ -239,12 +239,25 @@ AStarPlanner::AStarPlanner(const AStarOptions& options) : options_(options), imp
       !(options.ease_max_m >= 0.0) || !(options.penalty_range_m >= 0.0) || !(options.penalty_weight >= 0.0)) {
     throw std::invalid_argument("AStarOptions: radius, easing and penalty values must be >= 0");
   }
+  if (options.search == SearchAlgorithm::kJumpPoint && options.penalty_weight > 0.0 && options.penalty_range_m > 0.0) {
+    throw std::invalid_argument(
+        "AStarOptions: jump point search needs uniform step costs (penalty_weight = 0 or penalty_range_m = 0)");
+  }
 }
 AStarPlanner::~AStarPlanner() = default;
 AStarPlanner::AStarPlanner(AStarPlanner&&) noexcept = default;
 AStarPlanner& AStarPlanner::operator=(AStarPlanner&&) noexcept = default;
 
 bool AStarPlanner::has_map() const { return impl_->width > 0; }
+
+bool AStarPlanner::UsesJumpPoints() const {
+  switch (options_.search) {
+    case SearchAlgorithm::kAStar: return false;
+    case SearchAlgorithm::kJumpPoint: return true;
+    case SearchAlgorithm::kAuto: break;
+  }
+  return !(options_.penalty_weight > 0.0 && options_.penalty_range_m > 0.0);
+}
 
 void AStarPlanner::SetMap(const ObstacleDistanceGrid& d) {
   Impl& m = *impl_;
@@ -288,8 +301,10 @@ void AStarPlanner::SetMap(const ObstacleDistanceGrid& d) {
   if (m.nodes.size() != n) {
     m.nodes.assign(n, Impl::Node{0.0, -1, 0});
     m.generation = 0;
+    m.jps_marks.Resize(n);
   }
   m.components.clear();
+  m.passable.clear();
 }
 
 std::vector<double> AStarPlanner::EasingClearances() const {
@@ -371,15 +386,32 @@ PlanResult AStarPlanner::PlanAtClearance(const motion::Pose2D& start, const moti
   bool budget_hit = false;
   const int64_t budget = options_.node_budget;
   r.searches = 1;
-  if (!m.Search(s, g, c, budget, &r.expansions, &budget_hit)) {
+  r.jump_points = UsesJumpPoints();
+  bool found;
+  if (r.jump_points) {
+    found = detail::JumpPointSearch(m.PassableAt(c), m.stride, s, g, m.jps_marks, m.nodes, m.heap, budget,
+                                    &r.expansions, &budget_hit);
+  } else {
+    found = m.Search(s, g, c, budget, &r.expansions, &budget_hit);
+  }
+  if (!found) {
     r.status = budget_hit ? PlanStatus::kBudgetExhausted : PlanStatus::kUnreachable;
     return r;
   }
   r.status = PlanStatus::kFound;
   r.cost = m.nodes[g].g;
-  std::vector<int> cells;
-  for (int i = g; i != -1; i = m.nodes[i].parent) cells.push_back(i);
-  std::reverse(cells.begin(), cells.end());
+  std::vector<int> chain;
+  for (int i = g; i != -1; i = m.nodes[i].parent) chain.push_back(i);
+  std::reverse(chain.begin(), chain.end());
+  // Every cell of the path: A*'s parents are neighbours; jump points are joined by straight or
+  // diagonal runs, filled in here.
+  std::vector<int> cells = {chain.front()};
+  for (size_t i = 1; i < chain.size(); ++i) {
+    const int dx = chain[i] % m.stride - chain[i - 1] % m.stride, dy = chain[i] / m.stride - chain[i - 1] / m.stride;
+    const int step = (dy > 0 ? m.stride : dy < 0 ? -m.stride : 0) + (dx > 0 ? 1 : dx < 0 ? -1 : 0);
+    for (int k = chain[i - 1] + step; k != chain[i]; k += step) cells.push_back(k);
+    cells.push_back(chain[i]);
+  }
   std::vector<motion::Pose2D> path;
   path.reserve(cells.size());
   double length_cells = 0.0;

@@ -20,6 +20,12 @@ enum class PruneMode {
   kLineOfSight,  // collinear, then skip waypoints while the straight segment keeps the clearance
 };
 
+enum class SearchAlgorithm {
+  kAuto,       // jump point search where every step costs its length (no penalty), A* otherwise
+  kAStar,      // A* over every cell
+  kJumpPoint,  // jump point search (needs uniform step costs: no clearance penalty)
+};
+
 struct AStarOptions {
   double robot_radius_m = 0.10;  // cells whose obstacle distance is <= this are never entered
   // Easing factor: the first search requires clearance robot_radius_m + ease_start_m; each failed
@@ -38,6 +44,10 @@ struct AStarOptions {
   // Expansions allowed per search (0: as many as the grid has cells).
   int64_t node_budget = 0;
   PruneMode prune = PruneMode::kCollinear;
+  // Jump point search returns paths of the same (optimal) length as A* while expanding only the
+  // cells where an optimal path may turn; it applies when clearance is a hard limit and costs
+  // are uniform. CostsFrom is always Dijkstra over every cell.
+  SearchAlgorithm search = SearchAlgorithm::kAuto;
 };
 
 enum class PlanStatus {
@@ -62,6 +72,7 @@ struct PlanResult {
   double cost = 0.0;         // A* cost: length in cells plus penalties
   int64_t expansions = 0;    // nodes expanded over every search of this query
   int searches = 0;          // A* searches run (easing rungs actually searched)
+  bool jump_points = false;  // searched by jump point search (expansions count jump points)
 };
 
 // Plans on one distance grid. Setting the grid precomputes what every query shares (per-cell
@@ -90,6 +101,9 @@ class AStarPlanner {
 
   // Single search at a fixed clearance, no easing (Moving AI benchmarks, tests).
   PlanResult PlanAtClearance(const motion::Pose2D& start, const motion::Pose2D& goal, double clearance_m);
+
+  // Whether queries use jump point search (options().search, kAuto resolved).
+  bool UsesJumpPoints() const;
 
   // The clearances the easing tries, strictest first.
   std::vector<double> EasingClearances() const;
