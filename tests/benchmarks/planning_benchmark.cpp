@@ -36,8 +36,9 @@ const char* kDistanceMaps[] = {"botlab/mbot_example_logs_maps/drive_square.map",
 
 void BM_DistanceGrid_Ours(benchmark::State& state) {
   const OccupancyGrid& g = Map(kDistanceMaps[state.range(0)]);
+  planning::ObstacleDistanceGrid d(g, {});  // buffers kept, as OpenCV's output Mat is below
   for (auto _ : state) {
-    planning::ObstacleDistanceGrid d(g, {});
+    d.Recompute(g);
     benchmark::DoNotOptimize(d.distances().data());
   }
   state.SetLabel(std::to_string(g.width()) + "x" + std::to_string(g.height()));
@@ -58,6 +59,58 @@ void BM_DistanceGrid_OpenCV(benchmark::State& state) {
   }
   state.SetLabel(std::to_string(g.width()) + "x" + std::to_string(g.height()));
 }
+
+// One map update as an explorer sees it: a disk of radius `range(1)` cells that was unknown is now
+// seen (free, with its walls), then unseen again, alternately. Incremental: the distance grid's
+// Update plus the planner's UpdateMap; rebuild: a fresh transform plus SetMap. Exploration's
+// options (unknown cells are obstacles), the real 800×800 arena map.
+struct MapPair {
+  OccupancyGrid seen, unseen;
+};
+const MapPair& UpdatePair(int radius) {
+  static std::map<int, MapPair> cache;
+  auto it = cache.find(radius);
+  if (it != cache.end()) return it->second;
+  const OccupancyGrid& g = Map(kDistanceMaps[0]);
+  MapPair p{g, g};
+  const int cx = g.width() / 2, cy = g.height() / 2;
+  for (int y = cy - radius; y <= cy + radius; ++y)
+    for (int x = cx - radius; x <= cx + radius; ++x)
+      if ((x - cx) * (x - cx) + (y - cy) * (y - cy) <= radius * radius) p.unseen.at(x, y) = 0;
+  return cache.emplace(radius, std::move(p)).first->second;
+}
+const planning::ObstacleDistanceOptions kExploreDistance{true, 0, 0.0, -1};
+
+void BM_MapUpdate_Incremental(benchmark::State& state) {
+  const MapPair& p = UpdatePair(static_cast<int>(state.range(0)));
+  planning::ObstacleDistanceGrid d(p.seen, kExploreDistance);
+  planning::AStarPlanner planner;
+  planner.SetMap(d);
+  bool seen = false;
+  int64_t changed_cells = 0;
+  for (auto _ : state) {
+    const mbot::mapping::CellRect r = d.Update(seen ? p.seen : p.unseen);
+    planner.UpdateMap(d, r);
+    changed_cells += r.empty() ? 0 : int64_t{r.x1 - r.x0 + 1} * (r.y1 - r.y0 + 1);
+    seen = !seen;
+  }
+  state.SetLabel("800x800, a disk of radius " + std::to_string(state.range(0)) + " cells changes; " +
+                 std::to_string(changed_cells / std::max<int64_t>(1, state.iterations())) + " cells redone");
+}
+
+void BM_MapUpdate_Rebuild(benchmark::State& state) {
+  const MapPair& p = UpdatePair(static_cast<int>(state.range(0)));
+  planning::AStarPlanner planner;
+  bool seen = false;
+  for (auto _ : state) {
+    planner.SetMap(planning::ObstacleDistanceGrid(seen ? p.seen : p.unseen, kExploreDistance));
+    seen = !seen;
+  }
+  state.SetLabel("800x800, a disk of radius " + std::to_string(state.range(0)) + " cells changes");
+}
+
+BENCHMARK(BM_MapUpdate_Incremental)->Arg(20)->Arg(60)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MapUpdate_Rebuild)->Arg(20)->Arg(60)->Unit(benchmark::kMillisecond);
 
 // The reports' brushfire: BFS from obstacle cells over 8 neighbours, distance = parent's + step.
 // Not exact (it over-estimates off the 8 directions); the timing baseline only.

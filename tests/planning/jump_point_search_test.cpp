@@ -167,5 +167,36 @@ TEST(JumpPointSearchTest, StatusesAndBudget) {
   EXPECT_EQ(tight.Plan({0.5, 0.5, 0}, {2.2, 2.5, 0}).status, PlanStatus::kBudgetExhausted);
 }
 
+// A planner fed the changed cells only plans as one given the whole grid, with A* and with jump
+// point search (whose bit rows must not go stale).
+TEST(JumpPointSearchTest, UpdateMapPlansAsSetMap) {
+  OccupancyGrid g = RandomGrid(150, 110, 0.08, 9);
+  for (SearchAlgorithm search : {SearchAlgorithm::kJumpPoint, SearchAlgorithm::kAStar}) {
+    AStarOptions o = Uniform(search, 0.06);
+    if (search == SearchAlgorithm::kAStar) o.penalty_weight = 2.0;  // penalties updated in place too
+    ObstacleDistanceGrid d(g, {});
+    AStarPlanner updated(o);
+    updated.SetMap(d);
+    std::mt19937 rng(5);
+    std::uniform_int_distribution<int> xs(0, 149), ys(0, 109);
+    for (int step = 0; step < 6; ++step) {
+      for (int k = 0; k < 200; ++k) {  // flip cells in a patch
+        const int x = 20 * step + xs(rng) % 20, y = ys(rng);
+        g.at(x, y) = g.at(x, y) > 0 ? -100 : 100;
+      }
+      updated.UpdateMap(d, d.Update(g));
+      AStarPlanner fresh(o);
+      fresh.SetMap(ObstacleDistanceGrid(g, {}));
+      for (int q = 0; q < 30; ++q) {
+        const Pose2D s = CellCentre(g, xs(rng), ys(rng)), t = CellCentre(g, xs(rng), ys(rng));
+        const PlanResult a = updated.Plan(s, t), b = fresh.Plan(s, t);
+        ASSERT_EQ(a.status, b.status);
+        ASSERT_EQ(a.cost, b.cost);
+        ASSERT_EQ(a.path.size(), b.path.size());
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace mbot::planning

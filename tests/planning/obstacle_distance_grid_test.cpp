@@ -106,5 +106,63 @@ TEST(ObstacleDistanceGridTest, UnknownMarginCountsUnseenSpaceFarther) {
   EXPECT_EQ(unknown_free.at(6, 0), 6.0f);  // the margin only matters when unknown is an obstacle
 }
 
+// A map that grows as an explorer's does: unknown space becomes free, walls appear, a few cells flip
+// back; each Update must equal a build from scratch, cell for cell, and report every changed cell.
+void ExpectUpdatesMatchScratch(int w, int h, const ObstacleDistanceOptions& options, uint32_t seed) {
+  std::mt19937 rng(seed);
+  OccupancyGrid g(w, h, 0.05, -2.0, 1.0, 0);  // all unknown
+  for (int x = 0; x < w; ++x) g.at(x, h / 2) = (x % 7 == 0) ? 100 : -100;
+  ObstacleDistanceGrid incremental(options);
+  const mapping::CellRect first = incremental.Update(g);
+  EXPECT_EQ(first.x0, 0);
+  EXPECT_EQ(first.x1, w - 1);
+  EXPECT_EQ(first.y1, h - 1);
+  std::uniform_int_distribution<int> xs(0, w - 1), ys(0, h - 1), size(1, 25), kind(0, 9);
+  for (int step = 0; step < 12; ++step) {
+    const std::vector<float> before = incremental.distances();
+    // A patch seen (free with some walls), and now and then one far-away cell flipped.
+    const int cx = xs(rng), cy = ys(rng), r = size(rng);
+    for (int y = std::max(0, cy - r); y <= std::min(h - 1, cy + r); ++y) {
+      for (int x = std::max(0, cx - r); x <= std::min(w - 1, cx + r); ++x) {
+        const int k = kind(rng);
+        g.at(x, y) = k == 0 ? 100 : k == 1 ? 0 : -100;
+      }
+    }
+    if (step % 3 == 0) g.at(xs(rng), ys(rng)) = step % 2 ? 100 : -100;
+    const mapping::CellRect changed = incremental.Update(g);
+    const ObstacleDistanceGrid scratch(g, options);
+    ASSERT_EQ(incremental.distances(), scratch.distances()) << "step " << step;
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const size_t i = static_cast<size_t>(y) * w + x;
+        const bool inside =
+            !changed.empty() && x >= changed.x0 && x <= changed.x1 && y >= changed.y0 && y <= changed.y1;
+        if (!inside) ASSERT_EQ(before[i], scratch.distances()[i]) << "cell " << x << "," << y << " changed outside";
+      }
+    }
+  }
+  EXPECT_TRUE(incremental.Update(g).empty());  // nothing changed
+}
+
+TEST(ObstacleDistanceGridTest, IncrementalUpdatesEqualRebuilds) {
+  ExpectUpdatesMatchScratch(61, 47, {}, 1);
+  ExpectUpdatesMatchScratch(83, 29, {true, 0, 0.0, -1}, 2);
+  ExpectUpdatesMatchScratch(70, 90, {true, 0, 0.07, -1}, 3);   // a separate unknown margin
+  ExpectUpdatesMatchScratch(420, 300, {true, 0, 0.0, -1}, 4);  // large enough for the threaded passes
+}
+
+TEST(ObstacleDistanceGridTest, UpdateOfAnotherFrameRebuildsWhole) {
+  OccupancyGrid a(20, 10, 0.05, 0.0, 0.0, -100), b(20, 10, 0.05, 0.5, 0.0, -100), c(25, 10, 0.05, 0.0, 0.0, -100);
+  a.at(3, 3) = b.at(3, 3) = c.at(3, 3) = 100;
+  ObstacleDistanceGrid d(a, {});
+  const mapping::CellRect moved = d.Update(b);
+  EXPECT_EQ(moved.x1, 19);
+  EXPECT_EQ(moved.y1, 9);
+  EXPECT_EQ(d.origin_x(), 0.5);
+  const mapping::CellRect grown = d.Update(c);
+  EXPECT_EQ(grown.x1, 24);
+  EXPECT_EQ(d.distances(), ObstacleDistanceGrid(c, {}).distances());
+}
+
 }  // namespace
 }  // namespace mbot::planning

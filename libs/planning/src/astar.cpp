@@ -276,14 +276,7 @@ void AStarPlanner::SetMap(const ObstacleDistanceGrid& d) {
   m.use_penalty = options_.penalty_weight > 0.0 && options_.penalty_range_m > 0.0;
   m.penalty.assign(m.use_penalty ? n : 0, 0.0f);
   if (m.use_penalty) {
-    const double range = options_.penalty_range_m;
-    for (size_t i = 0; i < n; ++i) {
-      const double dd = m.dist[i];
-      if (dd >= 0.0 && dd < range) {
-        m.penalty[i] =
-            static_cast<float>(options_.penalty_weight * std::pow((range - dd) / range, options_.penalty_exponent));
-      }
-    }
+    for (size_t i = 0; i < n; ++i) m.penalty[i] = PenaltyAt(m.dist[i]);
   }
   // 4-neighbours first (the component labelling uses offsets 0..3), then diagonals with their sides.
   const int s = m.stride;
@@ -303,6 +296,35 @@ void AStarPlanner::SetMap(const ObstacleDistanceGrid& d) {
     m.generation = 0;
     m.jps_marks.Resize(n);
   }
+  m.components.clear();
+  m.passable.clear();
+}
+
+float AStarPlanner::PenaltyAt(float distance) const {
+  const double range = options_.penalty_range_m;
+  if (!(distance >= 0.0f) || !(distance < range)) return 0.0f;
+  return static_cast<float>(options_.penalty_weight * std::pow((range - distance) / range, options_.penalty_exponent));
+}
+
+void AStarPlanner::UpdateMap(const ObstacleDistanceGrid& d, const mapping::CellRect& changed) {
+  Impl& m = *impl_;
+  if (m.width != d.width() || m.height != d.height() || m.resolution != d.resolution() || m.origin_x != d.origin_x() ||
+      m.origin_y != d.origin_y()) {
+    SetMap(d);
+    return;
+  }
+  if (changed.empty()) return;
+  const int x0 = std::max(0, changed.x0), x1 = std::min(m.width - 1, changed.x1);
+  const int y0 = std::max(0, changed.y0), y1 = std::min(m.height - 1, changed.y1);
+  for (int y = y0; y <= y1; ++y) {
+    const float* src = &d.distances()[static_cast<size_t>(y) * m.width];
+    for (int x = x0; x <= x1; ++x) {
+      const int i = m.Index(x, y);
+      m.dist[i] = src[x];
+      if (m.use_penalty) m.penalty[i] = PenaltyAt(src[x]);
+    }
+  }
+  // Connectivity and the jump point rows span the grid: rebuilt when next asked for.
   m.components.clear();
   m.passable.clear();
 }

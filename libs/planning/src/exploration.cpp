@@ -32,7 +32,10 @@ const char* ToString(ExplorationState s) {
 }
 
 Explorer::Explorer(const ExplorationOptions& options)
-    : options_(options), planner_(options.astar), home_retries_left_(options.home_retries) {}
+    : options_(options),
+      distances_(options.distance),
+      planner_(options.astar),
+      home_retries_left_(options.home_retries) {}
 
 bool Explorer::IsBlacklisted(const Frontier& f, double t_s, bool* for_good) const {
   bool found = false;
@@ -142,7 +145,7 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
     u.reason = failure_reason_;
     return u;
   }
-  planner_.SetMap(ObstacleDistanceGrid(map, options_.distance));
+  planner_.UpdateMap(distances_, distances_.Update(map));
   int cx, cy;
   map.WorldToCell(pose.x, pose.y, &cx, &cy);
   if (!map.IsInside(cx, cy)) {

@@ -88,6 +88,10 @@ class AStarPlanner {
   const AStarOptions& options() const { return options_; }
   // Takes a copy of the distances it needs; the grid may be discarded afterwards.
   void SetMap(const ObstacleDistanceGrid& distances);
+  // After ObstacleDistanceGrid::Update: takes in only the cells it reported changed (their
+  // distances and penalties); connectivity and jump point rows are rebuilt when next needed. The
+  // same planner as SetMap(distances) gives. A grid of another size or frame is taken whole.
+  void UpdateMap(const ObstacleDistanceGrid& distances, const mapping::CellRect& changed);
   bool has_map() const;
 
   // Plans from `start` to `goal` (world frame, metres). Throws std::logic_error without a map.
@@ -121,6 +125,7 @@ class AStarPlanner {
 
  private:
   struct Impl;
+  float PenaltyAt(float distance) const;
   AStarOptions options_;
   std::unique_ptr<Impl> impl_;
 };

@@ -86,6 +86,7 @@ class Explorer {
   std::vector<FrontierLeft> FrontiersLeft(const mapping::OccupancyGrid& map, const motion::Pose2D& pose, double t_s);
 
   ExplorationOptions options_;
+  ObstacleDistanceGrid distances_;  // kept up to date incrementally as the map grows
   AStarPlanner planner_;
   ExplorationState state_ = ExplorationState::kInitializing;
   motion::Pose2D home_;

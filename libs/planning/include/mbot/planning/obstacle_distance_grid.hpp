@@ -1,12 +1,14 @@
 // Distance from every cell to the nearest obstacle cell, in metres: an exact Euclidean distance
 // transform (Felzenszwalb & Huttenlocher's lower-envelope pass per row and column), so the result
 // equals a brushfire whose wavefront carries the true Euclidean distance between cell centres.
+// Kept up to date incrementally: Update recomputes only what the cells that changed can reach.
 #pragma once
 
 #include <cstdint>
 #include <limits>
 #include <vector>
 
+#include "mbot/mapping/distance_transform.hpp"
 #include "mbot/mapping/occupancy_grid.hpp"
 
 namespace mbot::planning {
@@ -34,9 +36,22 @@ class ObstacleDistanceGrid {
   static constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
   ObstacleDistanceGrid() = default;
+  // No map yet: the first Update builds everything.
+  explicit ObstacleDistanceGrid(const ObstacleDistanceOptions& options) : options_(options) {}
   // Builds the distances for `map` (same size, resolution and origin). A map without any obstacle
   // gives kInfinity everywhere.
   ObstacleDistanceGrid(const mapping::OccupancyGrid& map, const ObstacleDistanceOptions& options);
+
+  // Brings the distances up to date with a new version of the map, with the options built with:
+  // only the columns holding cells that changed class (obstacle, unknown, free) and then the rows
+  // whose column distances changed are recomputed; the result equals a build from scratch.
+  // Returns the cells whose distance changed: the whole grid when the map's size, resolution or
+  // origin changed (or on the first map), empty when nothing did.
+  mapping::CellRect Update(const mapping::OccupancyGrid& map);
+  // Recomputes everything from scratch, reusing the buffers.
+  void Recompute(const mapping::OccupancyGrid& map);
+
+  const ObstacleDistanceOptions& options() const { return options_; }
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -58,6 +73,14 @@ class ObstacleDistanceGrid {
   double origin_x_ = 0.0;
   double origin_y_ = 0.0;
   std::vector<float> dist_;
+  ObstacleDistanceOptions options_;
+  // The transforms of the obstacle cells and (with a separate unknown margin) of the unknown cells.
+  mapping::EuclideanDistanceTransform obstacles_, unknown_;
+  std::vector<uint8_t> obstacle_mask_, unknown_mask_;  // scratch, kept to save the allocations
+
+  bool SeparateUnknown() const { return options_.unknown_is_obstacle && options_.unknown_margin_m > 0; }
+  void Masks(const mapping::OccupancyGrid& map);
+  void Distances(const mapping::CellRect& rect);
 };
 
 }  // namespace mbot::planning
