@@ -129,9 +129,10 @@ FilterStatus ParticleFilter::Update(const ActionModel& action, const OdometrySte
   log_w_.resize(n);
   const uint64_t move_base = StreamKey(seed_, kTagMove, static_cast<uint64_t>(updates_));
   const int threads = options_.threads > 0 ? options_.threads : omp_get_max_threads();
+  const ActionModel::StepNoise noise = action.NoiseOf(step);
 #pragma omp parallel for schedule(static) num_threads(threads) if (n >= 256)
   for (int i = 0; i < n; ++i) {
-    particles_[i].pose = action.Sample(particles_[i].pose, step, StreamKey(move_base, 0, i));
+    particles_[i].pose = action.Sample(particles_[i].pose, step, noise, StreamKey(move_base, 0, i));
     log_w_[i] = sensor.LogLikelihood(particles_[i].pose, scan);
   }
 

@@ -6,6 +6,7 @@
 namespace mbot::motion {
 
 double WrapAngle(double a) {
+  if (a > -M_PI && a <= M_PI) return a;  // already wrapped: returned as is (and without an fmod)
   a = std::fmod(a + M_PI, 2.0 * M_PI);
   if (a <= 0.0) a += 2.0 * M_PI;
   return a - M_PI;

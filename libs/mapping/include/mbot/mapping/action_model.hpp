@@ -31,8 +31,18 @@ class ActionModel {
   }
   // Whether the step from `from` to `to` is large enough to update the filter.
   bool Moved(const motion::Pose2D& from, const motion::Pose2D& to) const;
+  // The standard deviations of rot1, trans and rot2 for one step (the same for every particle).
+  struct StepNoise {
+    double rot1, trans, rot2;
+  };
+  StepNoise NoiseOf(const OdometryStep& step) const;
   // A sample of the particle's pose after `step`, drawn from the random stream `key`.
-  motion::Pose2D Sample(const motion::Pose2D& particle, const OdometryStep& step, uint64_t key) const;
+  motion::Pose2D Sample(const motion::Pose2D& particle, const OdometryStep& step, uint64_t key) const {
+    return Sample(particle, step, NoiseOf(step), key);
+  }
+  // The same with the step's noise worked out once for all particles.
+  motion::Pose2D Sample(const motion::Pose2D& particle, const OdometryStep& step, const StepNoise& noise,
+                        uint64_t key) const;
   const ActionModelOptions& options() const { return options_; }
 
  private:
