@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 #include "mbot/mapping/distance_transform.hpp"
 
 namespace mbot::mapping {
@@ -123,6 +127,81 @@ ScanPoints SensorModel::Prepare(const std::vector<ScanRay>& rays) const {
   return pts;
 }
 
+namespace {
+
+// One pose's likelihood-field lookup: float cell coordinates shifted by the table's one-cell border,
+// clamped into the padded table (anything off the map lands on the border's off-map value) and
+// truncated.
+struct FieldPose {
+  float fx, fy, fc, fs, max_x, max_y;
+  int pw;
+  int Cell(float x, float y) const {
+    const float gx = std::min(max_x, std::max(0.0f, fx + fc * x - fs * y));
+    const float gy = std::min(max_y, std::max(0.0f, fy + fs * x + fc * y));
+    return static_cast<int>(gy) * pw + static_cast<int>(gx);
+  }
+};
+
+constexpr int kLanes = 8;
+
+// The lanes' sums, added in a fixed order.
+float LaneTotal(const float* acc) {
+  return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+}
+
+// Branch-free, eight beams at a time: their cells are worked out together (the loop vectorises),
+// then summed into eight running sums (beam i into lane i mod 8), so no addition waits for the one
+// before it.
+float FieldSum(const FieldPose& p, const float* xs, const float* ys, size_t n, const float* table) {
+  float acc[kLanes] = {};
+  int32_t idx[kLanes];
+  size_t i = 0;
+  for (; i + kLanes <= n; i += kLanes) {
+    for (int k = 0; k < kLanes; ++k) idx[k] = p.Cell(xs[i + k], ys[i + k]);
+    for (int k = 0; k < kLanes; ++k) acc[k] += table[idx[k]];
+  }
+  for (int k = 0; i < n; ++i, ++k) acc[k] += table[p.Cell(xs[i], ys[i])];
+  return LaneTotal(acc);
+}
+
+#if defined(__x86_64__)
+// The same sums with AVX2: eight cells per instruction and one gather. The operations and their
+// order are FieldSum's (no fused multiply-add: the file is built with -ffp-contract=off).
+__attribute__((target("avx2"))) float FieldSumAvx2(const FieldPose& p, const float* xs, const float* ys, size_t n,
+                                                   const float* table) {
+  const __m256 fx = _mm256_set1_ps(p.fx), fy = _mm256_set1_ps(p.fy);
+  const __m256 fc = _mm256_set1_ps(p.fc), fs = _mm256_set1_ps(p.fs);
+  const __m256 max_x = _mm256_set1_ps(p.max_x), max_y = _mm256_set1_ps(p.max_y), zero = _mm256_setzero_ps();
+  const __m256i pw = _mm256_set1_epi32(p.pw);
+  __m256 acc = _mm256_setzero_ps();
+  size_t i = 0;
+  for (; i + kLanes <= n; i += kLanes) {
+    const __m256 x = _mm256_loadu_ps(xs + i), y = _mm256_loadu_ps(ys + i);
+    __m256 gx = _mm256_sub_ps(_mm256_add_ps(fx, _mm256_mul_ps(fc, x)), _mm256_mul_ps(fs, y));
+    __m256 gy = _mm256_add_ps(_mm256_add_ps(fy, _mm256_mul_ps(fs, x)), _mm256_mul_ps(fc, y));
+    gx = _mm256_min_ps(_mm256_max_ps(gx, zero), max_x);  // maxps(v, 0) is 0 for a NaN, as std::max(0, v)
+    gy = _mm256_min_ps(_mm256_max_ps(gy, zero), max_y);
+    const __m256i idx = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(gy), pw), _mm256_cvttps_epi32(gx));
+    acc = _mm256_add_ps(acc, _mm256_i32gather_ps(table, idx, 4));
+  }
+  alignas(32) float lanes[kLanes];
+  _mm256_store_ps(lanes, acc);
+  for (int k = 0; i < n; ++i, ++k) lanes[k] += table[p.Cell(xs[i], ys[i])];
+  return LaneTotal(lanes);
+}
+#endif
+
+}  // namespace
+
+bool SensorModel::SimdAvailable() {
+#if defined(__x86_64__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+#else
+  return false;
+#endif
+}
+
 double SensorModel::LogLikelihood(const motion::Pose2D& pose, const ScanPoints& scan) const {
   if (!has_map()) return 0.0;  // action-only: every pose weighs the same
   const double c = std::cos(pose.theta), s = std::sin(pose.theta);
@@ -139,23 +218,22 @@ double SensorModel::LogLikelihood(const motion::Pose2D& pose, const ScanPoints& 
   };
   double sum = 0.0;
   if (options_.kind == SensorModelKind::kLikelihoodField) {
-    // Branch-free: float cell coordinates shifted by the one-cell border, truncated and clamped into
-    // the padded table (anything off the map lands on the border's off-map value).
-    const float fc = static_cast<float>(c * inv_res), fs = static_cast<float>(s * inv_res);
-    const float fx = static_cast<float>(bx + 1.0), fy = static_cast<float>(by + 1.0);
-    const int max_x = width_ + 1, max_y = height_ + 1, pw = width_ + 2;
-    const float* xs = scan.x.data();
-    const float* ys = scan.y.data();
-    const float* table = padded_.data();
-    float acc = 0.0f;
-    for (size_t i = 0; i < n; ++i) {
-      const float gx = fx + fc * xs[i] - fs * ys[i];
-      const float gy = fy + fs * xs[i] + fc * ys[i];
-      const int cx = std::min(max_x, std::max(0, static_cast<int>(std::max(gx, -1.0f))));
-      const int cy = std::min(max_y, std::max(0, static_cast<int>(std::max(gy, -1.0f))));
-      acc += table[cy * pw + cx];
+    const FieldPose p{static_cast<float>(bx + 1.0),
+                      static_cast<float>(by + 1.0),
+                      static_cast<float>(c * inv_res),
+                      static_cast<float>(s * inv_res),
+                      static_cast<float>(width_ + 1),
+                      static_cast<float>(height_ + 1),
+                      width_ + 2};
+#if defined(__x86_64__)
+    if (options_.simd && SimdAvailable()) {
+      sum = FieldSumAvx2(p, scan.x.data(), scan.y.data(), n, padded_.data());
+    } else {
+      sum = FieldSum(p, scan.x.data(), scan.y.data(), n, padded_.data());
     }
-    sum = acc;
+#else
+    sum = FieldSum(p, scan.x.data(), scan.y.data(), n, padded_.data());
+#endif
   } else {
     const double w = options_.neighbour_weight;
     for (size_t i = 0; i < n; ++i) {
