@@ -23,7 +23,8 @@ mkdir -p "$out"
 gbench() {  # name binary filter: medians of $reps repetitions, as CSV
   echo "bench.sh: $2 ($3) ..." >&2
   MBOT_DATASETS_DIR=$datasets "$b/$2" --benchmark_filter="$3" --benchmark_repetitions="$reps" \
-    --benchmark_report_aggregates_only=true --benchmark_format=csv >"$out/$1.csv" 2>"$out/$1.log" || {
+    --benchmark_report_aggregates_only=true --benchmark_out="$out/$1.csv" --benchmark_out_format=csv \
+    >"$out/$1.log" 2>&1 || {
     echo "bench.sh: $2 failed, see $out/$1.log" >&2
     exit 1
   }

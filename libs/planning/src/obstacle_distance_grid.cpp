@@ -34,6 +34,7 @@ void ObstacleDistanceGrid::Masks(const mapping::OccupancyGrid& map) {
     }
   } else {
     const int blocked_above = options_.unknown_is_obstacle ? free_at : threshold;
+#pragma omp parallel for schedule(static) if (n > 100000)
     for (size_t i = 0; i < n; ++i) o[i] = cells[i] > blocked_above;
   }
 }
@@ -52,15 +53,20 @@ void ObstacleDistanceGrid::Distances(const CellRect& rect) {
       out[x] = sq[x] == EuclideanDistanceTransform::kNoObstacle ? kInfinity : m;
     }
   };
-  std::vector<float> scratch(separate ? width_ : 0);
-  for (int y = rect.y0; y <= rect.y1; ++y) {
-    const size_t row = static_cast<size_t>(y) * width_;
-    float* out = &dist_[row];
-    metres_row(&obstacles_.squared()[row], out, 0.0f);
-    if (!separate) continue;
-    const int32_t* unknown = &unknown_.squared()[row];
-    metres_row(unknown, scratch.data(), margin);
-    for (int x = rect.x0; x <= rect.x1; ++x) out[x] = unknown[x] == 0 ? 0.0f : std::min(out[x], scratch[x]);
+  const size_t cells = static_cast<size_t>(rect.x1 - rect.x0 + 1) * (rect.y1 - rect.y0 + 1);
+#pragma omp parallel if (cells > 100000)
+  {
+    std::vector<float> scratch(separate ? width_ : 0);
+#pragma omp for schedule(static)
+    for (int y = rect.y0; y <= rect.y1; ++y) {
+      const size_t row = static_cast<size_t>(y) * width_;
+      float* out = &dist_[row];
+      metres_row(&obstacles_.squared()[row], out, 0.0f);
+      if (!separate) continue;
+      const int32_t* unknown = &unknown_.squared()[row];
+      metres_row(unknown, scratch.data(), margin);
+      for (int x = rect.x0; x <= rect.x1; ++x) out[x] = unknown[x] == 0 ? 0.0f : std::min(out[x], scratch[x]);
+    }
   }
 }
 
