@@ -35,7 +35,7 @@ TEST(PipelineTest, UnknownStageTypeListsTheKnownOnes) {
           "t.ini:6: [s] type: unknown stage type 'nope' (known: action_model_fit, astar_test, camera_calibration, "
           "exploration, "
           "inspect, lcm_bridge, map_writer, maze_generator, mission, motor_calibration, movingai_benchmark, odometry, "
-          "recorder, referee, slam, tag_detection, trajectory_writer)"),
+          "recorder, referee, slam, tag_detection, tag_sightings, trajectory_writer)"),
       std::string::npos)
       << e;
 }

@@ -4,7 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "maebot/maebot_encoders_t.hpp"
+#include "mbot_lcm_msgs/mbot_apriltag_array_t.hpp"
 #include "maebot/maebot_motor_command_t.hpp"
 #include "mbot_legacy/mbot_encoder_t.hpp"
 #include "mbot_legacy/mbot_imu_t.hpp"
@@ -25,6 +28,49 @@ Event RoundTrip(const Event& in) {
   EXPECT_TRUE(lcm_adapter::Decode(in.channel, bytes.data(), bytes.size(), ChannelRoles{}, &out, &error)) << error;
   EXPECT_EQ(out.stamp_us, in.stamp_us);
   return out;
+}
+
+// Tag sightings go out as the botlab's publisher sends them (millimetres, degrees, quaternion
+// x y z w) and come back as the same metres and unit quaternion.
+TEST(LcmMessages, TagSightingsTravelAsTheBotlabsAprilTagArray) {
+  Event in;
+  in.kind = EventKind::kTagSightings;
+  in.channel = "MBOT_APRILTAG_ARRAY";
+  in.stamp_us = 1'700'000'000'000'000;
+  const double h = std::sqrt(0.5);  // 90° about the camera's x axis
+  in.payload = TagSightings{{{3, 0.1, -0.05, 0.75, h, h, 0.0, 0.0}, {12, -0.2, 0.0, 1.5, 1.0, 0.0, 0.0, 0.0}}};
+  std::vector<uint8_t> bytes;
+  ASSERT_TRUE(lcm_adapter::Encode(in, &bytes));
+  mbot_lcm_msgs::mbot_apriltag_array_t wire;
+  ASSERT_EQ(wire.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
+  ASSERT_EQ(wire.array_size, 2);
+  EXPECT_EQ(wire.detections[0].tag_id, 3);
+  EXPECT_FLOAT_EQ(wire.detections[0].pose.x, 100.0f);  // mm
+  EXPECT_FLOAT_EQ(wire.detections[0].pose.z, 750.0f);
+  EXPECT_NEAR(wire.detections[0].pose.angles_rpy[0], 90.0f, 1e-4);  // degrees
+  EXPECT_NEAR(wire.detections[0].pose.angles_quat[0], h, 1e-6);     // x first, w last
+  EXPECT_NEAR(wire.detections[0].pose.angles_quat[3], h, 1e-6);
+  const Event out = RoundTrip(in);
+  ASSERT_EQ(out.kind, EventKind::kTagSightings);
+  const auto& tags = std::get<TagSightings>(out.payload).tags;
+  ASSERT_EQ(tags.size(), 2u);
+  EXPECT_EQ(tags[1].id, 12);
+  EXPECT_NEAR(tags[0].x_m, 0.1, 1e-6);
+  EXPECT_NEAR(tags[1].z_m, 1.5, 1e-6);
+  EXPECT_NEAR(tags[0].qw, h, 1e-6);
+  EXPECT_NEAR(tags[0].qx, h, 1e-6);
+  // A count that disagrees with the payload, and a quaternion that is not a rotation, are rejected.
+  std::string error;
+  Event ev;
+  std::vector<uint8_t> bad = bytes;
+  bad[19] = 3;  // array_size (big-endian int32 at offset 16) 2 → 3
+  EXPECT_FALSE(lcm_adapter::Decode("MBOT_APRILTAG_ARRAY", bad.data(), bad.size(), ChannelRoles{}, &ev, &error));
+  EXPECT_NE(error.find("array_size"), std::string::npos) << error;
+  wire.detections[1].pose.angles_quat[3] = 3.0f;
+  bad.resize(static_cast<size_t>(wire.getEncodedSize()));
+  wire.encode(bad.data(), 0, static_cast<int>(bad.size()));
+  EXPECT_FALSE(lcm_adapter::Decode("MBOT_APRILTAG_ARRAY", bad.data(), bad.size(), ChannelRoles{}, &ev, &error));
+  EXPECT_NE(error.find("tag 12"), std::string::npos) << error;
 }
 
 TEST(LcmMessages, VelocityCommandRoundTrips) {

@@ -23,7 +23,8 @@ const std::vector<StageType>& StageTypes() {
                                 LcmBridgeStageType(),
                                 MazeGeneratorStageType(),
                                 CameraCalibrationStageType(),
-                                TagDetectionStageType()};
+                                TagDetectionStageType(),
+                                TagSightingsStageType()};
     std::sort(t.begin(), t.end(), [](const StageType& a, const StageType& b) { return a.name < b.name; });
     return t;
   }();

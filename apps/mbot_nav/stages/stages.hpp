@@ -22,5 +22,6 @@ StageType LcmBridgeStageType();
 StageType MazeGeneratorStageType();
 StageType CameraCalibrationStageType();
 StageType TagDetectionStageType();
+StageType TagSightingsStageType();
 
 }  // namespace mbot::app

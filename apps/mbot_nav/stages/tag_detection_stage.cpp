@@ -12,6 +12,7 @@
 #include "mbot/common/log.hpp"
 #include "mbot/vision/apriltag_detector.hpp"
 #include "mbot/vision/images.hpp"
+#include "mbot/vision/vision_config.hpp"
 #include "report.hpp"
 #include "stages.hpp"
 
@@ -93,30 +94,20 @@ class TagDetectionStage : public Stage {
 }  // namespace
 
 StageType TagDetectionStageType() {
-  return {
-      "tag_detection",
-      "AprilTag detection with the reference detector on a folder of images, an image or a video; writes "
-      "tags.csv, tags.json and annotated PNGs",
-      [](config::Section& s) -> std::unique_ptr<Stage> {
-        TagDetectionOptions o;
-        vision::TagDetectorOptions& d = o.detector;
-        o.images = s.RequirePath("images", "a folder of images (sorted by name), one image, or a video");
-        o.every = s.GetInt("every_nth_frame", o.every, "video: use every n-th frame", 1, 100000);
-        o.timing_repeats = s.GetInt("timing_repeats", o.timing_repeats,
-                                    "detect each frame this many times and report the median time", 1, 10000);
-        o.annotate = s.GetBool("annotate", o.annotate, "write <image>_tags.png with the tags drawn (not for video)");
-        d.family = s.GetChoice("family", d.family,
-                               {"tag36h11", "tag25h9", "tag16h5", "tagStandard41h12", "tagCircle21h7"}, "tag family");
-        d.max_bits_corrected =
-            s.GetInt("max_bits_corrected", d.max_bits_corrected, "bit errors the decoder corrects", 0, 3);
-        d.decimate = s.GetDouble("decimate", d.decimate, "find quads on an image this much smaller", 1.0, 16.0);
-        d.blur_sigma = s.GetDouble("blur_sigma", d.blur_sigma, "Gaussian blur before quads (0: none) [px]", 0.0, 10.0);
-        d.refine_edges = s.GetBool("refine_edges", d.refine_edges, "snap quad edges to strong gradients");
-        d.decode_sharpening =
-            s.GetDouble("decode_sharpening", d.decode_sharpening, "sharpening of the decoded bits", 0.0, 10.0);
-        d.threads = s.GetInt("threads", d.threads, "detector threads", 1, 64);
-        return std::make_unique<TagDetectionStage>(o);
-      }};
+  return {"tag_detection",
+          "AprilTag detection with the reference detector on a folder of images, an image or a video; writes "
+          "tags.csv, tags.json and annotated PNGs",
+          [](config::Section& s) -> std::unique_ptr<Stage> {
+            TagDetectionOptions o;
+            o.images = s.RequirePath("images", "a folder of images (sorted by name), one image, or a video");
+            o.every = s.GetInt("every_nth_frame", o.every, "video: use every n-th frame", 1, 100000);
+            o.timing_repeats = s.GetInt("timing_repeats", o.timing_repeats,
+                                        "detect each frame this many times and report the median time", 1, 10000);
+            o.annotate =
+                s.GetBool("annotate", o.annotate, "write <image>_tags.png with the tags drawn (not for video)");
+            o.detector = vision::ParseTagDetectorOptions(s, o.detector);
+            return std::make_unique<TagDetectionStage>(o);
+          }};
 }
 
 }  // namespace mbot::app

@@ -9,6 +9,7 @@
 #include "maebot/maebot_imu_t.hpp"
 #include "maebot/maebot_motor_command_t.hpp"
 #include "mbot_lcm_msgs/exploration_status_t.hpp"
+#include "mbot_lcm_msgs/mbot_apriltag_array_t.hpp"
 #include "mbot_lcm_msgs/mbot_encoders_t.hpp"
 #include "mbot_lcm_msgs/mbot_imu_t.hpp"
 #include "mbot_lcm_msgs/mbot_message_received_t.hpp"
@@ -446,6 +447,30 @@ std::map<int64_t, Entry> BuildTable() {
   add(mbot_lcm_msgs::mbot_slam_reset_t::getHash(), "mbot_slam_reset_t", kCurrent,
       OtherWithString<mbot_lcm_msgs::mbot_slam_reset_t>(20, "slam_map_location"));
   add(mbot_w23::mbot_system_reset_t::getHash(), "mbot_system_reset_t", kW23, nullptr);
+  add(mbot_lcm_msgs::mbot_apriltag_array_t::getHash(), "mbot_apriltag_array_t", kCurrent,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        // array_size follows utime; each detection is an int32 id and a pose3D_t (8 + 3·4 + 3·4 + 4·4).
+        if (!CheckCount(d, n, 16, 4 + 48, "array_size", err)) return false;
+        mbot_lcm_msgs::mbot_apriltag_array_t m{};
+        if (!DecodeExact(d, n, &m, err)) return false;
+        TagSightings out;
+        for (const auto& t : m.detections) {
+          const auto& p = t.pose;
+          const double q[4] = {p.angles_quat[0], p.angles_quat[1], p.angles_quat[2], p.angles_quat[3]};
+          const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+          if (!Finite(p.x, p.y, p.z) || !std::isfinite(norm) || std::abs(norm - 1.0) > 1e-3) {
+            *err = "tag " + std::to_string(t.tag_id) + ": non-finite position or a quaternion that is not of unit norm";
+            return false;
+          }
+          // The botlab's publisher: millimetres; quaternion x, y, z, w.
+          out.tags.push_back(
+              {t.tag_id, p.x * 1e-3, p.y * 1e-3, p.z * 1e-3, q[3] / norm, q[0] / norm, q[1] / norm, q[2] / norm});
+        }
+        ev->kind = EventKind::kTagSightings;
+        ev->stamp_us = m.utime;
+        ev->payload = std::move(out);
+        return true;
+      });
   return t;
 }
 
@@ -590,6 +615,32 @@ bool Encode(const Event& ev, std::vector<uint8_t>* out) {
         m.path.push_back({ev.stamp_us, static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.theta)});
       }
       m.path_length = static_cast<int32_t>(m.path.size());
+      EncodeMessage(m, out);
+      return true;
+    }
+    case EventKind::kTagSightings: {
+      // As the botlab's publisher sends it: the camera frame in millimetres, roll-pitch-yaw in
+      // degrees (its XYZ convention), the quaternion as x, y, z, w.
+      mbot_lcm_msgs::mbot_apriltag_array_t m{};
+      m.utime = ev.stamp_us;
+      for (const TagSighting& s : std::get<TagSightings>(ev.payload).tags) {
+        mbot_lcm_msgs::mbot_apriltag_t t{};
+        t.tag_id = s.id;
+        t.pose.utime = ev.stamp_us;
+        t.pose.x = static_cast<float>(s.x_m * 1e3), t.pose.y = static_cast<float>(s.y_m * 1e3);
+        t.pose.z = static_cast<float>(s.z_m * 1e3);
+        const double w = s.qw, x = s.qx, y = s.qy, z = s.qz;  // rotation matrix entries from the quaternion
+        const double r00 = 1 - 2 * (y * y + z * z), r10 = 2 * (x * y + w * z), r20 = 2 * (x * z - w * y);
+        const double r21 = 2 * (y * z + w * x), r22 = 1 - 2 * (x * x + y * y);
+        const double deg = 180.0 / M_PI;
+        t.pose.angles_rpy[0] = static_cast<float>(std::atan2(r21, r22) * deg);
+        t.pose.angles_rpy[1] = static_cast<float>(std::atan2(-r20, std::hypot(r00, r10)) * deg);
+        t.pose.angles_rpy[2] = static_cast<float>(std::atan2(r10, r00) * deg);
+        t.pose.angles_quat[0] = static_cast<float>(x), t.pose.angles_quat[1] = static_cast<float>(y);
+        t.pose.angles_quat[2] = static_cast<float>(z), t.pose.angles_quat[3] = static_cast<float>(w);
+        m.detections.push_back(t);
+      }
+      m.array_size = static_cast<int32_t>(m.detections.size());
       EncodeMessage(m, out);
       return true;
     }

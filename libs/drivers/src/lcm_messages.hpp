@@ -32,7 +32,8 @@ bool Decode(const std::string& channel, const uint8_t* data, size_t size, const 
 // channel: lidar_t (angles clockwise again), pose2D_t for every pose kind, mbot_encoders_t,
 // mbot_imu_t, twist2D_t (velocity commands), mbot_motor_pwm_t, mbot_motor_vel_t, occupancy_grid_t
 // (maps), path2D_t (paths), particles_t, slam_status_t (kSlamStatus) and
-// exploration_status_t (kMissionStatus: the task's state as the botlab's constants). Returns false, leaving `out`
+// exploration_status_t (kMissionStatus: the task's state as the botlab's constants) and
+// mbot_apriltag_array_t (kTagSightings, as the botlab's publisher: mm, degrees). Returns false, leaving `out`
 // empty, for kinds that have no such message (calibration samples, plan requests, others).
 bool Encode(const Event& event, std::vector<uint8_t>* out);
 

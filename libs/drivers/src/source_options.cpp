@@ -13,6 +13,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "camera_source.hpp"
 #include "carmen_source.hpp"
 #include "lcm_live_source.hpp"
 #include "lcm_log_source.hpp"
@@ -69,6 +70,20 @@ LiveSourceOptions ParseLiveSourceOptions(config::Section& s) {
 
 // lcm_relay.cpp
 void ParseRelayOptions(config::Section& s, SourceOptions* o);
+
+void ParseCameraSourceOptions(config::Section& s, SourceOptions* out) {
+  CameraSourceOptions& o = out->camera;
+  auto doc = [](const char* text) { return std::string("type = camera: ") + text; };
+  o.fps =
+      s.GetDouble("camera_fps", o.fps, doc("replay: frames 1/fps apart; a device is asked for this rate"), 0.1, 1000.0);
+  o.width =
+      static_cast<int>(s.GetInt("camera_width", o.width, doc("a device is asked for this width [px]"), 16, 10000));
+  o.height =
+      static_cast<int>(s.GetInt("camera_height", o.height, doc("a device is asked for this height [px]"), 16, 10000));
+  o.timeout_s = s.GetDouble("camera_timeout_s", o.timeout_s,
+                            doc("a live camera silent this long ends the stream, reported [s]"), 0.01, 3600.0);
+  o.channel = s.GetString("camera_channel", o.channel, doc("the channel the frames are emitted on"));
+}
 std::unique_ptr<Source> OpenLcmRelay(const SourceOptions& options);
 
 namespace {
@@ -135,6 +150,11 @@ std::deque<SourceType> BuiltInTypes() {
   t.push_back({"lcm_live", "a robot (or the simulated one) on the LCM bus, in wall-clock time; path is the LCM url",
                nullptr, 0, [](config::Section& s, SourceOptions* o) { o->live = ParseLiveSourceOptions(s); },
                [](const SourceOptions& o) { return std::make_unique<LcmLiveSource>(o); }});
+  t.push_back({"camera",
+               "camera frames: a device index, a video file or a GStreamer pipeline (OpenCV VideoCapture), or an "
+               "image folder or file replayed at camera_fps",
+               IsImageFileOrFolder, -1, ParseCameraSourceOptions,
+               [](const SourceOptions& o) { return std::make_unique<CameraSource>(o); }});
   t.push_back({"none", "no input: for stages that make their own output (maze_generator)", nullptr, 0, nullptr,
                [](const SourceOptions&) { return std::make_unique<NoSource>(); }});
   t.push_back({"lcm_relay",
@@ -252,8 +272,9 @@ std::unique_ptr<Source> OpenSource(const SourceOptions& options) {
   const std::string type = options.type == "auto" ? DetectFormat(options.path) : options.type;
   const SourceType* t = FindSourceType(type);
   if (!t) throw std::runtime_error("source type '" + type + "' is not known");
-  // Only the A* cases come as a folder; a folder anywhere else would read as an empty file.
-  const bool bus = type == "lcm_live" || type == "lcm_relay" || type == "none";
+  // Only the A* cases come as a folder; a folder anywhere else would read as an empty file. A
+  // camera's path may be a device index or a pipeline: it checks its own.
+  const bool bus = type == "lcm_live" || type == "lcm_relay" || type == "none" || type == "camera";
   if (type != "astar_cases" && !bus && std::filesystem::is_directory(options.path)) {
     throw std::runtime_error(options.path + ": is a directory, not a " + type + " file");
   }
@@ -280,6 +301,8 @@ const char* ToString(EventKind kind) {
     case EventKind::kSlamStatus: return "SLAM status";
     case EventKind::kMissionStatus: return "mission status";
     case EventKind::kParticles: return "particles";
+    case EventKind::kTagSightings: return "tag sightings";
+    case EventKind::kCameraFrame: return "camera frame";
     case EventKind::kOther: return "other";
   }
   return "?";

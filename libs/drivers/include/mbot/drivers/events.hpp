@@ -102,6 +102,28 @@ struct Particles {
   std::vector<double> weights;
 };
 
+// One tag seen in a camera frame: its id and its pose in the camera frame (OpenCV's: x right, y
+// down, z forward from the optical centre), in metres, as a rotation tag frame → camera frame (unit
+// quaternion). On the wire (MBOT_APRILTAG_ARRAY, mbot_apriltag_array_t) it travels the way the
+// botlab's publisher sends it: millimetres, roll-pitch-yaw in degrees, the quaternion as x, y, z, w.
+struct TagSighting {
+  int id = 0;
+  double x_m = 0.0, y_m = 0.0, z_m = 0.0;
+  double qw = 1.0, qx = 0.0, qy = 0.0, qz = 0.0;
+};
+
+// Every tag seen in one camera frame (an empty list is a frame with none).
+struct TagSightings {
+  std::vector<TagSighting> tags;
+};
+
+// One 8-bit grey camera frame (row-major, width × height bytes), shared between stages without a copy.
+struct CameraFrame {
+  int width = 0, height = 0;
+  std::shared_ptr<const std::vector<uint8_t>> pixels;
+  std::string name;  // the file or device it came from, for reports
+};
+
 enum class EventKind {
   kLidar,          // LidarScan
   kOdometry,       // Pose2D, the robot's own dead-reckoning
@@ -120,6 +142,8 @@ enum class EventKind {
   kSlamStatus,     // mapping::SlamStatus: what SLAM's pose is worth (SLAM_STATUS)
   kMissionStatus,  // mission::MissionStatus: the state of the robot's task (exploration, competition event)
   kParticles,      // Particles: the localization's samples
+  kTagSightings,   // TagSightings: AprilTags seen in one camera frame (MBOT_APRILTAG_ARRAY)
+  kCameraFrame,    // CameraFrame: an image from a camera or an image folder
   kOther,          // recognised but not used by the pipeline (time sync, resets, legacy particles …)
 };
 
@@ -127,7 +151,7 @@ const char* ToString(EventKind kind);
 
 using Payload = std::variant<std::monostate, LidarScan, motion::Pose2D, EncoderTicks, Imu, MotorCommand, WheelSpeeds,
                              std::shared_ptr<const mapping::OccupancyGrid>, PlanRequest, WheelSample, Path,
-                             mapping::SlamStatus, mission::MissionStatus, Particles>;
+                             mapping::SlamStatus, mission::MissionStatus, Particles, TagSightings, CameraFrame>;
 
 struct Event {
   int64_t t_us = 0;      // event (reception / log) time; the order of the stream

@@ -28,6 +28,16 @@ struct ChannelRoles {
   std::vector<std::string> velocity_command = {"MBOT_VEL_CMD"};
 };
 
+// [source] type = camera: frames from a camera (path = a device index), a video file or a
+// GStreamer pipeline (OpenCV's VideoCapture), or an image folder or file replayed at `fps`.
+struct CameraSourceOptions {
+  double fps = 15.0;  // replay: frames are stamped 1/fps apart; a device is asked for this rate
+  int width = 640;    // a device is asked for this size
+  int height = 480;
+  double timeout_s = 2.0;  // a device that delivers no frame for this long ends the stream (reported)
+  std::string channel = "CAMERA";
+};
+
 // [source] type = lcm_live: a robot (or the simulated one) on the LCM bus, in wall-clock time.
 struct LiveSourceOptions {
   // The robot's channels the autonomy listens to (current mbot_lcm_msgs names).
@@ -59,8 +69,9 @@ struct SourceOptions {
   // Seed of the source's randomness, e.g. the simulator's noise ([pipeline] seed, copied here by
   // the pipeline; not a [source] key).
   uint64_t seed = 1;
-  LiveSourceOptions live;  // read only when type = lcm_live
-  RelayOptions relay;      // read only when type = lcm_relay (path is then its robot_url)
+  LiveSourceOptions live;      // read only when type = lcm_live
+  CameraSourceOptions camera;  // read only when type = camera
+  RelayOptions relay;          // read only when type = lcm_relay (path is then its robot_url)
   double relay_duration_s = 0.0;
   // The options of a source type registered by another library (the simulator's SimSourceOptions),
   // filled by that type's `parse`.

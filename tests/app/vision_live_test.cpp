@@ -1,0 +1,88 @@
+// config/vision_live.ini end to end on rendered frames: camera source (an image folder) → tag
+// sightings → the recorder and the LCM bridge (in-process memq://). What went out on
+// MBOT_APRILTAG_ARRAY, read back from the recorded log, holds every tag at its true place.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "../regression/run_config.hpp"
+#include "mbot/drivers/source_options.hpp"
+#include "mbot/vision/apriltag_detector.hpp"
+
+namespace mbot::app {
+namespace {
+
+// The shipped nominal camera (datasets/camera/mbot_camera_640x480.yaml).
+const cv::Matx33d kK(530, 0, 320, 0, 530, 240, 0, 0, 1);
+constexpr double kTagSize = 0.054;
+
+struct Truth {
+  int id;
+  cv::Vec3d rvec, t;
+};
+
+// The tags drawn where `tags` puts them (tag frame in the camera frame) on one grey frame.
+cv::Mat Render(const std::vector<Truth>& tags) {
+  cv::Mat frame(480, 640, CV_8UC1, cv::Scalar(128));
+  for (const Truth& tag : tags) {
+    const cv::Mat texture = vision::TagImage("tag36h11", tag.id, 20);
+    cv::Matx33d R;
+    cv::Rodrigues(tag.rvec, R);
+    const double s = kTagSize / 160.0, half = texture.cols / 2.0;
+    const cv::Matx33d S(s, 0, -half * s, 0, s, -half * s, 0, 0, 1);
+    const cv::Matx33d Rt(R(0, 0), R(0, 1), tag.t[0], R(1, 0), R(1, 1), tag.t[1], R(2, 0), R(2, 1), tag.t[2]);
+    cv::Mat warped, mask;
+    cv::warpPerspective(texture, warped, cv::Mat(kK * Rt * S), frame.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                        cv::Scalar(128));
+    cv::warpPerspective(cv::Mat(texture.size(), CV_8UC1, cv::Scalar(255)), mask, cv::Mat(kK * Rt * S), frame.size());
+    warped.copyTo(frame, mask);
+  }
+  return frame;
+}
+
+TEST(VisionLiveConfig, PublishesEveryTagWhereItIsAsTheBotlabsArray) {
+  const std::vector<std::vector<Truth>> frames = {
+      {{1, {0.2, -0.1, 0.05}, {-0.10, 0.02, 0.45}}, {2, {-0.1, 0.3, 0.0}, {0.12, -0.01, 0.6}}},
+      {{3, {0.0, 0.0, 0.4}, {0.0, 0.05, 0.35}}},
+      {},  // a frame with no tag: an empty array goes out
+      {{1, {0.3, 0.2, -0.3}, {0.05, 0.0, 0.8}}}};
+  const std::string dir = ::testing::TempDir() + "/vision_live_frames";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  for (size_t k = 0; k < frames.size(); ++k) {
+    cv::imwrite(dir + "/frame" + std::to_string(k) + ".png", Render(frames[k]));
+  }
+  const std::string json = RunConfig("vision_live.ini", "vision_live",
+                                     {"source.path=" + dir, "bridge.url=memq://", "tags.decimate=1"}, "sightings.json");
+  ASSERT_FALSE(json.empty());
+  EXPECT_EQ(Get(json, {"frames"}), 4);
+  EXPECT_EQ(Get(json, {"sightings"}), 4);
+
+  drivers::SourceOptions o;
+  o.path = ::testing::TempDir() + "/vision_live/sightings.log";
+  auto log = drivers::OpenSource(o);
+  size_t k = 0;
+  while (auto ev = log->Next()) {
+    ASSERT_EQ(ev->channel, "MBOT_APRILTAG_ARRAY");
+    ASSERT_EQ(ev->kind, drivers::EventKind::kTagSightings);
+    ASSERT_LT(k, frames.size());
+    EXPECT_EQ(ev->stamp_us, static_cast<int64_t>(std::llround(k * 1e6 / 15.0)));  // camera_fps = 15
+    const auto& got = std::get<drivers::TagSightings>(ev->payload).tags;
+    ASSERT_EQ(got.size(), frames[k].size()) << "frame " << k;
+    for (const Truth& truth : frames[k]) {
+      const auto it = std::find_if(got.begin(), got.end(), [&](const auto& s) { return s.id == truth.id; });
+      ASSERT_NE(it, got.end()) << "tag " << truth.id << " in frame " << k;
+      const cv::Vec3d position(it->x_m, it->y_m, it->z_m);
+      EXPECT_LT(cv::norm(position - truth.t), 0.01) << "tag " << truth.id << " in frame " << k << ": " << position;
+    }
+    ++k;
+  }
+  EXPECT_EQ(k, frames.size());
+}
+
+}  // namespace
+}  // namespace mbot::app
