@@ -2,6 +2,8 @@
 // configured with its own keys, opened), and the errors.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include <fstream>
 
 #include "mbot/common/config.hpp"
@@ -77,8 +79,11 @@ TEST(SourceRegistry, ErrorsNameThePath) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("/no/such/file.log: no such file"), std::string::npos) << e.what();
   }
+  // A folder that is not an A* case set and holds no image (a folder of images is a camera's).
+  const std::string folder = ::testing::TempDir() + "/source_registry_plain_folder";
+  std::filesystem::create_directories(folder);
   try {
-    DetectFormat(::testing::TempDir());
+    DetectFormat(folder);
     ADD_FAILURE();
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
