@@ -7,7 +7,7 @@
 #   scripts/bench.sh [repetitions (default 3)] [out_dir (default out/bench)]
 # Environment: MBOT_DATASETS_DIR (default ../shared/datasets), MOVINGAI_SAMPLE_EVERY (default 25:
 # every 25th scenario of each of the 19 Moving AI files; 1 runs all 62,186, about an hour).
-# Needs a Release build (scripts/build.sh). Takes about 10 minutes at the defaults on 2 cores.
+# Needs a Release build (scripts/build.sh). Takes about 3 minutes at the defaults on 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 reps=${1:-3}
@@ -22,8 +22,9 @@ mkdir -p "$out"
 
 gbench() {  # name binary filter: medians of $reps repetitions, as CSV
   echo "bench.sh: $2 ($3) ..." >&2
+  # JSON: Google Benchmark's CSV writer refuses runs whose counters differ (the SLAM benchmark's do).
   MBOT_DATASETS_DIR=$datasets "$b/$2" --benchmark_filter="$3" --benchmark_repetitions="$reps" \
-    --benchmark_report_aggregates_only=true --benchmark_out="$out/$1.csv" --benchmark_out_format=csv \
+    --benchmark_report_aggregates_only=true --benchmark_out="$out/$1.json" --benchmark_out_format=json \
     >"$out/$1.log" 2>&1 || {
     echo "bench.sh: $2 failed, see $out/$1.log" >&2
     exit 1
@@ -46,9 +47,14 @@ done
 
 # One table. `median NAME FILE` prints the median real time of benchmark NAME in ms.
 median() {
-  awk -F, -v n="\"$1_median\"" '$1 == n {
-    t = $3; u = $5; if (u == "us") t /= 1000; else if (u == "ns") t /= 1e6; else if (u == "s") t *= 1000
-    printf "%.4f", t; found = 1 } END { if (!found) printf "nan" }' "$out/$2.csv"
+  awk -v n="\"$1_median\"," '
+    $1 == "\"name\":" { hit = ($2 == n) }
+    hit && $1 == "\"real_time\":" { t = $2 + 0 }
+    hit && $1 == "\"time_unit\":" {
+      u = $2; gsub(/[",]/, "", u)
+      if (u == "us") t /= 1000; else if (u == "ns") t /= 1e6; else if (u == "s") t *= 1000
+      printf "%.4f", t; found = 1; hit = 0 }
+    END { if (!found) printf "nan" }' "$out/$2.json"
 }
 row() {  # what ours baseline baseline-name: ratio = baseline / ours (above 1: ours is faster)
   awk -v w="$1" -v a="$2" -v b="$3" -v n="$4" 'BEGIN {
