@@ -137,7 +137,9 @@ void ExpectUpdatesMatchScratch(int w, int h, const ObstacleDistanceOptions& opti
         const size_t i = static_cast<size_t>(y) * w + x;
         const bool inside =
             !changed.empty() && x >= changed.x0 && x <= changed.x1 && y >= changed.y0 && y <= changed.y1;
-        if (!inside) ASSERT_EQ(before[i], scratch.distances()[i]) << "cell " << x << "," << y << " changed outside";
+        if (!inside) {
+          ASSERT_EQ(before[i], scratch.distances()[i]) << "cell " << x << "," << y << " changed outside";
+        }
       }
     }
   }
