@@ -452,5 +452,23 @@ TEST(SimSource, SpeedOnAMazeArena) {
   EXPECT_GT(sim.robot().distance_travelled_m(), 5.0);
 }
 
+// A crate in front of the robot: the lidar sees its face, and driving into it is a collision.
+TEST(SimRobot, CratesAreSeenByTheLidarAndBlockTheBody) {
+  World world = World::ParseArena("box -2 -2 2 2\ncrate 3 0.6 0 0\n", "crate.arena");
+  SimRobotOptions o;
+  o.lidar.range_noise_m = 0.0;
+  o.lidar.dropout = 0.0;
+  SimRobot robot(world, o, {0, 0, 0}, 4);
+  const auto events = Drive(robot, 0, 0, 0.13);
+  const auto scans = OfKind(events, EventKind::kLidar);
+  ASSERT_EQ(scans.size(), 1u);
+  const auto& scan = std::get<LidarScan>(scans[0].payload);
+  const Pose2D sensor = Pose2D{0, 0, 0}.Compose(o.lidar.mount);
+  EXPECT_NEAR(scan.ranges_m[0], 0.55 - sensor.x, 1e-5);  // beam 0 looks straight ahead at the face
+  const auto drove = Drive(robot, 0.2, 0, 4.0);
+  EXPECT_GE(robot.collisions(), 1);
+  EXPECT_LT(robot.true_pose().x, 0.55 - o.footprint_radius_m + 0.01);  // stopped at the crate's face
+}
+
 }  // namespace
 }  // namespace mbot::sim

@@ -285,6 +285,7 @@ World World::Load(const std::string& path) {
 World World::ParseArena(const std::string& text, const std::string& origin) {
   std::vector<WallSegment> walls;
   std::vector<ArenaPose> poses;
+  std::vector<std::pair<Crate, int>> crates;  // with their lines, added once the walls exist
   std::string name;
   double thickness = 0.02, resolution = 0.025;
   int name_line = 0, resolution_line = 0, first_wall_line = 0;
@@ -367,8 +368,21 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
       p.pose.y = number(stmt, args[2]);
       p.pose.theta = motion::WrapAngle(number(stmt, args[3]) * kPi / 180.0);
       poses.push_back(p);
+    } else if (stmt == "crate") {
+      if (args.size() != 4 && args.size() != 7) {
+        fail("'crate' needs <id> <x> <y> <theta_deg> [<width> <depth> <height>], got " + std::to_string(args.size()));
+      }
+      Crate c;
+      const double id = number(stmt, args[0]);
+      if (id < 0 || id > 586 || id != std::floor(id)) fail("'crate' id " + args[0] + " is not a tag36h11 id (0-586)");
+      c.id = static_cast<int>(id);
+      c.pose = {number(stmt, args[1]), number(stmt, args[2]), motion::WrapAngle(number(stmt, args[3]) * kPi / 180.0)};
+      if (args.size() == 7) {
+        c.width_m = number(stmt, args[4]), c.depth_m = number(stmt, args[5]), c.height_m = number(stmt, args[6]);
+      }
+      crates.push_back({c, line_no});
     } else {
-      fail("unknown statement '" + stmt + "' (known: name, resolution, thickness, wall, box, pose)");
+      fail("unknown statement '" + stmt + "' (known: name, resolution, thickness, wall, box, pose, crate)");
     }
   }
   if (walls.empty()) throw std::runtime_error(origin + ": no walls (an arena needs at least one 'wall' or 'box')");
@@ -380,6 +394,13 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
   }
   w.name_ = name.empty() ? fs::path(origin).stem().string() : name;
   w.poses_ = std::move(poses);
+  for (const auto& [crate, at] : crates) {
+    try {
+      w.AddCrate(crate);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(origin + ":" + std::to_string(at) + ": " + e.what());
+    }
+  }
   return w;
 }
 
@@ -507,13 +528,81 @@ World World::FromGrid(const mapping::OccupancyGrid& grid) {
   return w;
 }
 
-double World::Raycast(double x, double y, double angle_rad, double max_range_m) const {
-  if (!index_ || !std::isfinite(x) || !std::isfinite(y)) return 0.0;
-  if (!is_grid_world()) return RaycastArena(*index_, x, y, angle_rad, max_range_m);
-  return RaycastGrid(truth_, x, y, angle_rad, max_range_m);
+double Crate::DistanceTo(double x, double y) const {
+  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  const double dx = x - pose.x, dy = y - pose.y;
+  const double u = std::abs(c * dx + s * dy) - 0.5 * width_m, v = std::abs(-s * dx + c * dy) - 0.5 * depth_m;
+  return std::hypot(std::max(u, 0.0), std::max(v, 0.0));
 }
 
-double World::ClearanceAt(double x, double y) const {
+double Crate::RayDistance(double x, double y, double angle_rad) const {
+  // Slabs in the crate's frame.
+  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  const double dx = x - pose.x, dy = y - pose.y;
+  const double px = c * dx + s * dy, py = -s * dx + c * dy;
+  const double a = angle_rad - pose.theta, ux = std::cos(a), uy = std::sin(a);
+  double t0 = 0.0, t1 = kInf;
+  const double half[2] = {0.5 * width_m, 0.5 * depth_m}, p[2] = {px, py}, u[2] = {ux, uy};
+  for (int k = 0; k < 2; ++k) {
+    if (std::abs(u[k]) < 1e-15) {
+      if (std::abs(p[k]) > half[k]) return kInf;
+      continue;
+    }
+    double ta = (-half[k] - p[k]) / u[k], tb = (half[k] - p[k]) / u[k];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return kInf;
+  }
+  return t0;
+}
+
+void World::AddCrate(const Crate& crate) {
+  const std::string which = "crate " + std::to_string(crate.id);
+  if (!(crate.width_m > 0 && crate.depth_m > 0 && crate.height_m > 0) || !std::isfinite(crate.pose.x) ||
+      !std::isfinite(crate.pose.y) || !std::isfinite(crate.pose.theta)) {
+    throw std::invalid_argument(which + ": sides must be positive and the pose finite");
+  }
+  // Overlap tests on points every 2 mm round each footprint's edge, and its centre: a wall (at least
+  // 1 mm thick, and a capsule) or another box cannot lie across an edge between two of them unseen,
+  // and one box wholly inside another shows by its centre.
+  auto outline = [](const Crate& k) {
+    const double c = std::cos(k.pose.theta), s = std::sin(k.pose.theta);
+    std::vector<std::pair<double, double>> points = {{k.pose.x, k.pose.y}};
+    const double hw = 0.5 * k.width_m, hd = 0.5 * k.depth_m;
+    const double corners[5][2] = {{-hw, -hd}, {hw, -hd}, {hw, hd}, {-hw, hd}, {-hw, -hd}};
+    for (int e = 0; e < 4; ++e) {
+      const double ex = corners[e + 1][0] - corners[e][0], ey = corners[e + 1][1] - corners[e][1];
+      const int n = std::max(1, static_cast<int>(std::ceil(std::hypot(ex, ey) / 0.002)));
+      for (int i = 0; i < n; ++i) {
+        const double u = corners[e][0] + ex * i / n, v = corners[e][1] + ey * i / n;
+        points.emplace_back(k.pose.x + c * u - s * v, k.pose.y + s * u + c * v);
+      }
+    }
+    return points;
+  };
+  const auto mine = outline(crate);
+  for (const auto& [x, y] : mine) {
+    if (WallsClearanceAt(x, y) <= 0.0) throw std::invalid_argument(which + ": overlaps a wall or leaves the world");
+  }
+  for (const Crate& other : crates_) {
+    bool overlap = false;
+    for (const auto& [x, y] : mine) overlap = overlap || other.DistanceTo(x, y) <= 0.0;
+    for (const auto& [x, y] : outline(other)) overlap = overlap || crate.DistanceTo(x, y) <= 0.0;
+    if (overlap) throw std::invalid_argument(which + ": overlaps crate " + std::to_string(other.id));
+  }
+  crates_.push_back(crate);
+}
+
+double World::Raycast(double x, double y, double angle_rad, double max_range_m) const {
+  if (!index_ || !std::isfinite(x) || !std::isfinite(y)) return 0.0;
+  double range = is_grid_world() ? RaycastGrid(truth_, x, y, angle_rad, max_range_m)
+                                 : RaycastArena(*index_, x, y, angle_rad, max_range_m);
+  for (const Crate& crate : crates_) range = std::min(range, crate.RayDistance(x, y, angle_rad));
+  return range;
+}
+
+double World::WallsClearanceAt(double x, double y) const {
   if (!index_ || !std::isfinite(x) || !std::isfinite(y)) return 0.0;
   if (!is_grid_world()) return std::max(0.0, NearestSegmentDistance(*index_, x, y) - index_->h);
   int cx, cy;
@@ -522,7 +611,20 @@ double World::ClearanceAt(double x, double y) const {
   return GridClearance(truth_, *index_, x, y);
 }
 
+double World::ClearanceAt(double x, double y) const {
+  double clearance = WallsClearanceAt(x, y);
+  for (const Crate& crate : crates_) clearance = std::min(clearance, crate.DistanceTo(x, y));
+  return clearance;
+}
+
 bool World::Collides(double x, double y, double radius_m) const {
+  for (const Crate& crate : crates_) {
+    if (crate.DistanceTo(x, y) <= std::max(radius_m, 0.0)) return true;
+  }
+  return WallsCollide(x, y, radius_m);
+}
+
+bool World::WallsCollide(double x, double y, double radius_m) const {
   if (!index_) return true;
   const double r = std::max(radius_m, 0.0);
   const double x0 = truth_.origin_x(), y0 = truth_.origin_y();

@@ -29,6 +29,10 @@ struct WallSegment {
 //   pose <label> <x> <y> <theta>     a named pose (theta in degrees); labels used by the competition:
 //                                    start, waypoint (in order, the speed-run circuit), target,
 //                                    dropoff (in order, warehouse levels); any label may repeat
+//   crate <id> <x> <y> <theta> [<width> <depth> <height>]
+//                                    a crate (Heavy Lift): a box standing on the floor, centred at
+//                                    (x, y), turned theta degrees, its sides in metres (default
+//                                    0.10 × 0.10 × 0.08), a tag36h11 tag `id` on each vertical face
 // Errors name the file and the line. Walls are capsules: the segment thickened by thickness/2 on
 // every side, ends rounded (so walls meeting at a corner leave no notch); Raycast, Collides and
 // ClearanceAt all use that one shape. One thickness per arena: a `thickness` statement after the
@@ -36,6 +40,22 @@ struct WallSegment {
 struct ArenaPose {
   std::string label;
   motion::Pose2D pose;
+};
+
+// A crate: a box on the floor that the lidar sees and the robot's body must not touch. Not part of
+// the true map (crates move; the maps scored are the walls'). The defaults are botlab-like: a
+// 10 cm cube-ish box a little lower than wide, so the MBot's fork (about 5 cm up) meets its faces.
+struct Crate {
+  int id = 0;             // the tag36h11 id printed on each vertical face
+  motion::Pose2D pose;    // centre on the floor, heading of its x side
+  double width_m = 0.10;  // along its own x
+  double depth_m = 0.10;  // along its own y
+  double height_m = 0.08;
+  // Distance from (x, y) to the box's footprint (0 inside or on it).
+  double DistanceTo(double x, double y) const;
+  // Distance along the ray from (x, y) at `angle_rad` to the footprint's boundary, 0 when (x, y) is
+  // inside, +inf when the ray misses it.
+  double RayDistance(double x, double y, double angle_rad) const;
 };
 
 struct WorldIndex;
@@ -73,6 +93,11 @@ class World {
   const std::vector<ArenaPose>& poses() const { return poses_; }
   std::vector<motion::Pose2D> PosesLabelled(const std::string& label) const;
   const std::vector<WallSegment>& walls() const { return walls_; }
+  // Crates (Heavy Lift): Raycast, Collides and ClearanceAt see them as well as the walls.
+  const std::vector<Crate>& crates() const { return crates_; }
+  // Adds a crate; throws std::invalid_argument when its sides are not positive or it overlaps a wall
+  // or another crate (naming its id).
+  void AddCrate(const Crate& crate);
   double wall_thickness() const { return thickness_; }  // 0 for a grid world
   bool is_grid_world() const { return walls_.empty(); }
 
@@ -81,6 +106,9 @@ class World {
   std::vector<WallSegment> walls_;  // empty for a grid world
   double thickness_ = 0.02;
   std::vector<ArenaPose> poses_;
+  std::vector<Crate> crates_;
+  double WallsClearanceAt(double x, double y) const;
+  bool WallsCollide(double x, double y, double radius_m) const;
   mapping::OccupancyGrid truth_;
   // Acceleration structures (bucket grid over the walls, or the grid's distance transform), built
   // once and shared by copies; defined in world.cpp.
