@@ -310,8 +310,9 @@ TEST(SimWorld, LoadsArenaAndMapFilesAndNamesTheFileInErrors) {
     World::Load(arena_path);
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
-    EXPECT_EQ(std::string(e.what()),
-              arena_path + ":3: unknown statement 'bogus' (known: name, resolution, thickness, wall, box, pose, crate)");
+    EXPECT_EQ(
+        std::string(e.what()),
+        arena_path + ":3: unknown statement 'bogus' (known: name, resolution, thickness, wall, box, pose, crate)");
   }
   std::ofstream(arena_path) << "box 0 0 2 1\npose start 0.5 0.5 0\n";
   const World a = World::Load(arena_path);
