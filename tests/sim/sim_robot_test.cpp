@@ -470,5 +470,36 @@ TEST(SimRobot, CratesAreSeenByTheLidarAndBlockTheBody) {
   EXPECT_LT(robot.true_pose().x, 0.55 - o.footprint_radius_m + 0.01);  // stopped at the crate's face
 }
 
+// crates_at_random: the run's seed places the crates (the same seed, the same crates), inside the
+// square, clear of the start; more than fit is an error naming the file.
+TEST(SimSource, CratesAtRandomComeFromTheSeed) {
+  const std::string path = WriteArena("crates.arena", std::string(kRoom) + "crates_at_random 3 0.6 0 0.8 5\n");
+  auto crates_of = [&](uint64_t seed) {
+    SourceOptions o = ParseSource("[source]\ntype = sim\npath = " + path + "\n");
+    o.seed = seed;
+    auto source = OpenSource(o);
+    return dynamic_cast<SimSource&>(*source).world().crates();
+  };
+  const std::vector<Crate> a = crates_of(1), b = crates_of(1), c = crates_of(2);
+  ASSERT_EQ(a.size(), 3u);
+  for (size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(a[k].id, static_cast<int>(5 + k));
+    EXPECT_EQ(a[k].pose.x, b[k].pose.x);
+    EXPECT_EQ(a[k].pose.theta, b[k].pose.theta);
+    EXPECT_LE(std::abs(a[k].pose.x - 0.6), 0.4);
+    EXPECT_LE(std::abs(a[k].pose.y), 0.4);
+    EXPECT_GE(a[k].DistanceTo(-0.5, 0.0), 0.2);  // the start, clear by footprint + 0.1 m
+  }
+  EXPECT_NE(a[0].pose.x, c[0].pose.x);
+  const std::string crowded = WriteArena("crowded.arena", std::string(kRoom) + "crates_at_random 20 0.6 0 0.3 1\n");
+  try {
+    OpenSource(ParseSource("[source]\ntype = sim\npath = " + crowded + "\n"));
+    FAIL() << "20 crates fitted in a 0.3 m square";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("crowded.arena: crates_at_random: only"), std::string::npos) << e.what();
+  }
+  EXPECT_NE(std::string(World::ParseArena("box -1 -1 1 1\n", "x").crate_area() ? "set" : "none"), "set");
+}
+
 }  // namespace
 }  // namespace mbot::sim

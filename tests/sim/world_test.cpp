@@ -64,7 +64,8 @@ TEST(SimWorld, ParseErrorsNameTheLineAndToken) {
   EXPECT_EQ(ParseError("# walls\n\nwall 0 0 1\n"), "a.arena:3: 'wall' needs 4 numbers, got 3");
   EXPECT_EQ(ParseError("wall 0 0 1 1 1\n"), "a.arena:1: 'wall' needs 4 numbers, got 5");
   EXPECT_EQ(ParseError("wall 0 0 1 1\nwal 0 0 1 1\n"),
-            "a.arena:2: unknown statement 'wal' (known: name, resolution, thickness, wall, box, pose, crate)");
+            "a.arena:2: unknown statement 'wal' (known: name, resolution, thickness, wall, box, pose, crate, "
+            "crates_at_random)");
   EXPECT_EQ(ParseError("wall 0 0 1 x1\n"), "a.arena:1: 'wall': 'x1' is not a number");
   EXPECT_EQ(ParseError("box 0 0 1 1e400\n"), "a.arena:1: 'box': '1e400' is not a finite number");
   EXPECT_EQ(ParseError("wall 0 0 1 nan\n"), "a.arena:1: 'wall': 'nan' is not a finite number");
@@ -310,9 +311,9 @@ TEST(SimWorld, LoadsArenaAndMapFilesAndNamesTheFileInErrors) {
     World::Load(arena_path);
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
-    EXPECT_EQ(
-        std::string(e.what()),
-        arena_path + ":3: unknown statement 'bogus' (known: name, resolution, thickness, wall, box, pose, crate)");
+    EXPECT_EQ(std::string(e.what()), arena_path +
+                                         ":3: unknown statement 'bogus' (known: name, resolution, thickness, wall, "
+                                         "box, pose, crate, crates_at_random)");
   }
   std::ofstream(arena_path) << "box 0 0 2 1\npose start 0.5 0.5 0\n";
   const World a = World::Load(arena_path);
@@ -555,6 +556,9 @@ TEST(SimWorld, CratesAreSeenAndTouchedButNotMapped) {
   EXPECT_NE(ParseError("box -1 -1 1 1\ncrate 7 0.98 0 0\n").find("a.arena:2: crate 7: overlaps a wall"),
             std::string::npos)
       << ParseError("box -1 -1 1 1\ncrate 7 0.98 0 0\n");
+  EXPECT_NE(ParseError("box -1 -1 1 1\ncrates_at_random 0 0 0\n").find("a.arena:2: 'crates_at_random' count 0"),
+            std::string::npos);
+  EXPECT_NE(ParseError("box -1 -1 1 1\ncrates_at_random 3 0 0 1 585\n").find("leave tag36h11"), std::string::npos);
   EXPECT_NE(ParseError("box -1 -1 1 1\ncrate 1 0 0 0\ncrate 2 0.05 0 0\n").find("a.arena:3: crate 2: overlaps crate 1"),
             std::string::npos);
 }

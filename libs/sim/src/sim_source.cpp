@@ -51,6 +51,14 @@ SimSource::SimSource(const SourceOptions& options, const SimSourceOptions& sim)
       start_(StartPose(options, sim, world_)),
       robot_(MakeRobot(options, sim, world_, start_)),
       realtime_factor_(sim.realtime_factor) {
+  if (const auto& area = world_.crate_area()) {
+    // The robot reads the world by reference: crates added now are seen from its first step.
+    try {
+      PlaceCratesAtRandom(&world_, *area, seed_, start_, sim.robot.footprint_radius_m + 0.1);
+    } catch (const std::runtime_error& e) {
+      throw std::runtime_error(options.path + ": " + e.what());
+    }
+  }
   const std::string gen = "simulated";
   channels_[sim_channel::kEncoders] = ChannelInfo{"mbot_encoders_t", gen, EventKind::kEncoders, true};
   channels_[sim_channel::kImu] = ChannelInfo{"mbot_imu_t", gen, EventKind::kImu, true};

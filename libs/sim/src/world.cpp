@@ -286,6 +286,7 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
   std::vector<WallSegment> walls;
   std::vector<ArenaPose> poses;
   std::vector<std::pair<Crate, int>> crates;  // with their lines, added once the walls exist
+  std::optional<CrateArea> crate_area;
   std::string name;
   double thickness = 0.02, resolution = 0.025;
   int name_line = 0, resolution_line = 0, first_wall_line = 0;
@@ -381,8 +382,30 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
         c.width_m = number(stmt, args[4]), c.depth_m = number(stmt, args[5]), c.height_m = number(stmt, args[6]);
       }
       crates.push_back({c, line_no});
+    } else if (stmt == "crates_at_random") {
+      if (args.size() != 3 && args.size() != 5) {
+        fail("'crates_at_random' needs <count> <x> <y> [<side> <first_id>], got " + std::to_string(args.size()));
+      }
+      if (crate_area) fail("'crates_at_random' given twice");
+      CrateArea a;
+      const double count = number(stmt, args[0]);
+      if (count < 1 || count > 20 || count != std::floor(count))
+        fail("'crates_at_random' count " + args[0] + " not in 1-20");
+      a.count = static_cast<int>(count);
+      a.x = number(stmt, args[1]), a.y = number(stmt, args[2]);
+      if (args.size() == 5) {
+        a.side_m = number(stmt, args[3]);
+        const double first = number(stmt, args[4]);
+        if (!(a.side_m > 0.1 && a.side_m <= 20)) fail("'crates_at_random' side " + args[3] + " not in (0.1, 20] m");
+        if (first < 0 || first + a.count - 1 > 586 || first != std::floor(first)) {
+          fail("'crates_at_random' ids from " + args[4] + " leave tag36h11 (0-586)");
+        }
+        a.first_id = static_cast<int>(first);
+      }
+      crate_area = a;
     } else {
-      fail("unknown statement '" + stmt + "' (known: name, resolution, thickness, wall, box, pose, crate)");
+      fail("unknown statement '" + stmt +
+           "' (known: name, resolution, thickness, wall, box, pose, crate, crates_at_random)");
     }
   }
   if (walls.empty()) throw std::runtime_error(origin + ": no walls (an arena needs at least one 'wall' or 'box')");
@@ -394,6 +417,7 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
   }
   w.name_ = name.empty() ? fs::path(origin).stem().string() : name;
   w.poses_ = std::move(poses);
+  w.crate_area_ = crate_area;
   for (const auto& [crate, at] : crates) {
     try {
       w.AddCrate(crate);
@@ -765,6 +789,35 @@ motion::Pose2D RandomFreePose(const World& world, double clearance_m, uint64_t s
   }
   throw std::runtime_error("RandomFreePose: no place in '" + world.name() + "' keeps " + Num(clearance_m) +
                            " m from every wall (10,000 draws)");
+}
+
+void PlaceCratesAtRandom(World* world, const CrateArea& area, uint64_t seed, const motion::Pose2D& keep_clear,
+                         double keep_clear_m) {
+  std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ULL + 0xC2A7E5);
+  std::uniform_real_distribution<double> u(-0.5 * area.side_m, 0.5 * area.side_m), uth(-M_PI, M_PI);
+  int placed = 0;
+  for (int draw = 0; draw < 10'000 && placed < area.count; ++draw) {
+    Crate c;
+    c.id = area.first_id + placed;
+    c.pose = {area.x + u(rng), area.y + u(rng), uth(rng)};
+    // The whole footprint inside the square, and clear of the start.
+    const double reach = 0.5 * std::hypot(c.width_m, c.depth_m);
+    if (std::abs(c.pose.x - area.x) + reach > 0.5 * area.side_m ||
+        std::abs(c.pose.y - area.y) + reach > 0.5 * area.side_m)
+      continue;
+    if (c.DistanceTo(keep_clear.x, keep_clear.y) < keep_clear_m) continue;
+    try {
+      world->AddCrate(c);
+    } catch (const std::invalid_argument&) {
+      continue;  // on a wall or another crate: draw again
+    }
+    ++placed;
+  }
+  if (placed < area.count) {
+    throw std::runtime_error("crates_at_random: only " + std::to_string(placed) + " of " + std::to_string(area.count) +
+                             " crates fit in the " + Num(area.side_m) + " m square at (" + Num(area.x) + ", " +
+                             Num(area.y) + ") of '" + world->name() + "' (10,000 draws)");
+  }
 }
 
 }  // namespace mbot::sim

@@ -8,6 +8,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,6 +34,10 @@ struct WallSegment {
 //                                    a crate (Heavy Lift): a box standing on the floor, centred at
 //                                    (x, y), turned theta degrees, its sides in metres (default
 //                                    0.10 × 0.10 × 0.08), a tag36h11 tag `id` on each vertical face
+//   crates_at_random <count> <x> <y> [<side> <first_id>]
+//                                    `count` crates (ids first_id, first_id + 1, …; default 1) of the
+//                                    default size at random poses inside the side × side square
+//                                    (default 1 m) centred at (x, y), drawn from the run's seed
 // Errors name the file and the line. Walls are capsules: the segment thickened by thickness/2 on
 // every side, ends rounded (so walls meeting at a corner leave no notch); Raycast, Collides and
 // ClearanceAt all use that one shape. One thickness per arena: a `thickness` statement after the
@@ -40,6 +45,14 @@ struct WallSegment {
 struct ArenaPose {
   std::string label;
   motion::Pose2D pose;
+};
+
+// A request for crates at random (arena statement crates_at_random), resolved with a run's seed.
+struct CrateArea {
+  int count = 1;
+  double x = 0.0, y = 0.0;  // the square's centre
+  double side_m = 1.0;
+  int first_id = 1;
 };
 
 // A crate: a box on the floor that the lidar sees and the robot's body must not touch. Not part of
@@ -98,6 +111,8 @@ class World {
   // Adds a crate; throws std::invalid_argument when its sides are not positive or it overlaps a wall
   // or another crate (naming its id).
   void AddCrate(const Crate& crate);
+  // The arena's crates_at_random request, if any (PlaceCratesAtRandom resolves it).
+  const std::optional<CrateArea>& crate_area() const { return crate_area_; }
   double wall_thickness() const { return thickness_; }  // 0 for a grid world
   bool is_grid_world() const { return walls_.empty(); }
 
@@ -107,6 +122,7 @@ class World {
   double thickness_ = 0.02;
   std::vector<ArenaPose> poses_;
   std::vector<Crate> crates_;
+  std::optional<CrateArea> crate_area_;
   double WallsClearanceAt(double x, double y) const;
   bool WallsCollide(double x, double y, double radius_m) const;
   mapping::OccupancyGrid truth_;
@@ -142,5 +158,12 @@ EventInputs EventInputsOf(const World& world);
 // space when it has none) that keeps `clearance_m` from every wall, heading uniform; the same seed
 // gives the same pose. Throws when 10,000 draws find no such place.
 motion::Pose2D RandomFreePose(const World& world, double clearance_m, uint64_t seed);
+
+// Adds area.count crates of the default size at uniform random positions and headings inside the
+// area's square, each clear of the walls, of the other crates and by `keep_clear_m` of `keep_clear`
+// (the robot's start, so the robot does not start touching one). The same seed gives the same
+// crates. Throws std::runtime_error naming the world when 10,000 draws cannot place them all.
+void PlaceCratesAtRandom(World* world, const CrateArea& area, uint64_t seed, const motion::Pose2D& keep_clear,
+                         double keep_clear_m);
 
 }  // namespace mbot::sim
