@@ -226,7 +226,7 @@ double SensorModel::LogLikelihood(const motion::Pose2D& pose, const ScanPoints& 
                       static_cast<float>(height_ + 1),
                       width_ + 2};
 #if defined(__x86_64__)
-    if (options_.simd && SimdAvailable()) {
+    if (use_simd_) {
       sum = FieldSumAvx2(p, scan.x.data(), scan.y.data(), n, padded_.data());
     } else {
       sum = FieldSum(p, scan.x.data(), scan.y.data(), n, padded_.data());

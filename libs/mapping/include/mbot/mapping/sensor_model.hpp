@@ -46,7 +46,8 @@ struct ScanPoints {
 
 class SensorModel {
  public:
-  explicit SensorModel(const SensorModelOptions& options) : options_(options) {}
+  explicit SensorModel(const SensorModelOptions& options)
+      : options_(options), use_simd_(options.simd && SimdAvailable()) {}
   // Builds the lookup tables for `map`; call again whenever the map changes. A map of the same
   // geometry as the last one only recomputes the distances near obstacles that appeared or vanished.
   void SetMap(const OccupancyGrid& map);
@@ -64,6 +65,7 @@ class SensorModel {
   void UpdateDistances(int x0, int y0, int x1, int y1);
 
   SensorModelOptions options_;
+  bool use_simd_ = false;  // options_.simd on a processor that has AVX2, decided once
   int width_ = 0, height_ = 0;
   double resolution_ = 0.05, origin_x_ = 0, origin_y_ = 0;
   std::vector<float> table_;  // simplified field: per-cell scaled log-odds
