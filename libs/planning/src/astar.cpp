@@ -14,9 +14,6 @@ namespace {
 constexpr double kSqrt2 = 1.4142135623730951;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-using detail::HeapEntry;
-using detail::HeapOrder;
-
 }  // namespace
 
 const char* ToString(PlanStatus s) {
@@ -47,8 +44,7 @@ struct AStarPlanner::Impl {
   std::vector<Node> nodes;
   uint32_t generation = 0;
   detail::SearchMarks jps_marks;
-  std::vector<HeapEntry> heap;
-  std::vector<int> fast;
+  detail::OpenList open;
 
   // Connected components (4-connected, which is what 8-connected moves without corner cutting
   // reach) of the passable cells per clearance, computed on first use.
@@ -165,24 +161,12 @@ struct AStarPlanner::Impl {
       const int dx = std::abs(x - gx), dy = std::abs(y - gy);
       return dx > dy ? dx + (kSqrt2 - 1.0) * dy : dy + (kSqrt2 - 1.0) * dx;
     };
-    heap.clear();
-    fast.clear();
+    open.Clear();
     nodes[start] = Node{0.0, -1, open_mark};
-    heap.push_back({h(start % stride, start / stride), start, 0.0f});
-    const HeapOrder order;
+    open.Push(start, h(start % stride, start / stride), 0.0, kInf);
     int64_t expanded = 0;
-    while (!fast.empty() || !heap.empty()) {
-      // Successors whose f equals the f being expanded are minimal already: they skip the heap
-      // and are expanded next (on open grids most successors are such, so most heap work goes).
-      int cur;
-      if (!fast.empty()) {
-        cur = fast.back();
-        fast.pop_back();
-      } else {
-        std::pop_heap(heap.begin(), heap.end(), order);
-        cur = heap.back().index;
-        heap.pop_back();
-      }
+    while (!open.Empty()) {
+      const int cur = open.Pop();
       Node& node = nodes[cur];
       if (node.mark == closed_mark) continue;  // stale duplicate of a node already expanded
       node.mark = closed_mark;
@@ -215,13 +199,7 @@ struct AStarPlanner::Impl {
         const double g = g_cur + step;
         if (nn.mark == open_mark && g >= nn.g) continue;
         nn = Node{g, cur, open_mark};
-        const double f = g + h(cx + dxs[k], cy + dys[k]);
-        if (f <= f_cur + 1e-9) {
-          fast.push_back(n);
-        } else {
-          heap.push_back({f, n, static_cast<float>(g)});
-          std::push_heap(heap.begin(), heap.end(), order);
-        }
+        open.Push(n, g + h(cx + dxs[k], cy + dys[k]), g, f_cur);
       }
     }
     *expansions += expanded;
@@ -411,7 +389,7 @@ PlanResult AStarPlanner::PlanAtClearance(const motion::Pose2D& start, const moti
   r.jump_points = UsesJumpPoints();
   bool found;
   if (r.jump_points) {
-    found = detail::JumpPointSearch(m.PassableAt(c), m.stride, s, g, m.jps_marks, m.nodes, m.heap, budget,
+    found = detail::JumpPointSearch(m.PassableAt(c), m.stride, s, g, m.jps_marks, m.nodes, m.open, budget,
                                     &r.expansions, &budget_hit);
   } else {
     found = m.Search(s, g, c, budget, &r.expansions, &budget_hit);

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 
 namespace mbot::planning::detail {
 namespace {
 
 constexpr double kSqrt2 = 1.4142135623730951;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // 64 cells from bit `pos` on (bit i = cell pos + i). The arrays carry two spare words at the end.
 inline uint64_t BitsAt(const uint64_t* line, int pos) {
@@ -95,8 +97,8 @@ int PassableBits::JumpStraight(int x, int y, int dx, int dy, int goal_x, int goa
 // Diagonally, a cell is a jump point when it is the goal or when either straight scan from it
 // (along the two components of the move) finds one. With corner cutting ruled out, diagonal
 // moves have no forced neighbours.
-int PassableBits::Jump(int x, int y, int dx, int dy, int goal) const {
-  const int goal_x = goal % stride_, goal_y = goal / stride_;
+int PassableBits::Jump(int x, int y, int dx, int dy, int goal_x, int goal_y) const {
+  const int goal = goal_y * stride_ + goal_x;
   if (dx == 0 || dy == 0) return JumpStraight(x, y, dx, dy, goal_x, goal_y);
   while (true) {
     if (!Open(x + dx, y) || !Open(x, y + dy) || !Open(x + dx, y + dy)) return -1;
@@ -111,32 +113,21 @@ int PassableBits::Jump(int x, int y, int dx, int dy, int goal) const {
 }
 
 bool JumpPointSearch(const PassableBits& bits, int stride, int start, int goal, SearchMarks& marks,
-                     std::vector<SearchNode>& nodes, std::vector<HeapEntry>& heap, int64_t budget, int64_t* expansions,
+                     std::vector<SearchNode>& nodes, OpenList& open, int64_t budget, int64_t* expansions,
                      bool* budget_hit) {
   marks.Next();
   uint8_t* mark = marks.data();
   const uint8_t open_mark = marks.open(), closed_mark = marks.closed();
   const int gx = goal % stride, gy = goal / stride;
   auto h = [&](int x, int y) { return Octile(x - gx, y - gy); };
-  const HeapOrder order;
-  heap.clear();
+  open.Clear();
   nodes[start] = SearchNode{0.0, -1, 0};
   mark[start] = open_mark;
-  heap.push_back({h(start % stride, start / stride), start, 0.0f});
+  open.Push(start, h(start % stride, start / stride), 0.0, kInfinity);
   int64_t expanded = 0;
   int dirs[8][2];
-  std::vector<int> fast;
-  while (!fast.empty() || !heap.empty()) {
-    // As in A*: successors whose f equals the f being expanded are minimal already and skip the heap.
-    int cur;
-    if (!fast.empty()) {
-      cur = fast.back();
-      fast.pop_back();
-    } else {
-      std::pop_heap(heap.begin(), heap.end(), order);
-      cur = heap.back().index;
-      heap.pop_back();
-    }
+  while (!open.Empty()) {
+    const int cur = open.Pop();
     if (mark[cur] == closed_mark) continue;  // stale duplicate of a node already expanded
     mark[cur] = closed_mark;
     const SearchNode& node = nodes[cur];
@@ -181,7 +172,7 @@ bool JumpPointSearch(const PassableBits& bits, int stride, int start, int goal, 
       }
     }
     for (int k = 0; k < n; ++k) {
-      const int next = bits.Jump(cx, cy, dirs[k][0], dirs[k][1], goal);
+      const int next = bits.Jump(cx, cy, dirs[k][0], dirs[k][1], gx, gy);
       if (next < 0) continue;
       const uint8_t m = mark[next];
       if (m == closed_mark) continue;
@@ -191,13 +182,7 @@ bool JumpPointSearch(const PassableBits& bits, int stride, int start, int goal, 
       if (m == open_mark && g >= nn.g) continue;
       nn = SearchNode{g, cur, 0};
       mark[next] = open_mark;
-      const double f = g + h(nx, ny);
-      if (f <= f_cur + 1e-9) {
-        fast.push_back(next);
-      } else {
-        heap.push_back({f, next, static_cast<float>(g)});
-        std::push_heap(heap.begin(), heap.end(), order);
-      }
+      open.Push(next, g + h(nx, ny), g, f_cur);
     }
   }
   *expansions += expanded;

@@ -43,16 +43,52 @@ class SearchMarks {
   unsigned generation_ = 0;
 };
 
-// 16 bytes: f, the node, and g (as float, only to break ties).
-struct HeapEntry {
-  double f;
-  int32_t index;
-  float g;
-};
-// Smallest f first; among equal f the deeper node (larger g) first, which keeps the search from
-// fanning out over the many equal-cost paths of an open grid.
-struct HeapOrder {
-  bool operator()(const HeapEntry& a, const HeapEntry& b) const { return a.f > b.f || (a.f == b.f && a.g < b.g); }
+// The open list both searches use: a binary heap of (f, node, g) — smallest f first and among
+// equal f the deeper node (larger g), which keeps a search from fanning out over the many
+// equal-cost paths of an open grid — and a stack for successors whose f equals the f being expanded:
+// those are minimal already and are expanded next without touching the heap (on open grids most
+// successors are such). A node may be in it more than once; the search skips stale entries. A
+// 4-ary heap was measured slower here than std::pop_heap's sift of the hole to the bottom.
+class OpenList {
+ public:
+  void Clear() {
+    heap_.clear();
+    fast_.clear();
+  }
+  bool Empty() const { return fast_.empty() && heap_.empty(); }
+  // `node` reached with cost g and estimate f while expanding a node whose f is f_expanding
+  // (+inf for the start).
+  void Push(int32_t node, double f, double g, double f_expanding) {
+    if (f <= f_expanding + 1e-9) {
+      fast_.push_back(node);
+    } else {
+      heap_.push_back({f, node, static_cast<float>(g)});
+      std::push_heap(heap_.begin(), heap_.end(), Order{});
+    }
+  }
+  int32_t Pop() {
+    if (!fast_.empty()) {
+      const int32_t n = fast_.back();
+      fast_.pop_back();
+      return n;
+    }
+    std::pop_heap(heap_.begin(), heap_.end(), Order{});
+    const int32_t n = heap_.back().index;
+    heap_.pop_back();
+    return n;
+  }
+
+ private:
+  struct Entry {  // 16 bytes: g as float, only to break ties
+    double f;
+    int32_t index;
+    float g;
+  };
+  struct Order {
+    bool operator()(const Entry& a, const Entry& b) const { return a.f > b.f || (a.f == b.f && a.g < b.g); }
+  };
+  std::vector<Entry> heap_;
+  std::vector<int32_t> fast_;
 };
 
 // The cells passable at one clearance (obstacle distance > clearance) of a padded grid (a border of
@@ -66,8 +102,8 @@ class PassableBits {
   bool Open(int x, int y) const { return (Word(row_, row_words_, y, x >> 6) >> (x & 63)) & 1u; }
 
   // The first jump point from (x, y) stepping by (dx, dy) (one of the eight moves), or -1 when the
-  // scan runs into an obstacle (or, diagonally, past a corner) first. `goal` is a padded index.
-  int Jump(int x, int y, int dx, int dy, int goal) const;
+  // scan runs into an obstacle (or, diagonally, past a corner) first. The goal is a padded cell.
+  int Jump(int x, int y, int dx, int dy, int goal_x, int goal_y) const;
 
  private:
   static uint64_t Word(const std::vector<uint64_t>& bits, int words, int line, int w) {
@@ -89,7 +125,7 @@ class PassableBits {
 // jump point.
 // Returns true when the goal was closed; adds the nodes expanded to *expansions.
 bool JumpPointSearch(const PassableBits& bits, int stride, int start, int goal, SearchMarks& marks,
-                     std::vector<SearchNode>& nodes, std::vector<HeapEntry>& heap, int64_t budget, int64_t* expansions,
+                     std::vector<SearchNode>& nodes, OpenList& open, int64_t budget, int64_t* expansions,
                      bool* budget_hit);
 
 }  // namespace mbot::planning::detail
