@@ -12,6 +12,7 @@
 #include "mbot/common/log.hpp"
 #include "mbot/planning/astar.hpp"
 #include "mbot/planning/obstacle_distance_grid.hpp"
+#include "mbot/planning/planning_config.hpp"
 #include "report.hpp"
 #include "stages.hpp"
 
@@ -197,11 +198,7 @@ StageType MovingAiBenchmarkStageType() {
                                           "run only scenarios whose index is a multiple of this (1: every one; "
                                           "the default ctest run samples, the movingai_full label runs all)",
                                           1, 1000000));
-            const std::string search = s.GetChoice("search", "auto", {"auto", "astar", "jps"},
-                                                   "planner search: auto picks jump point search (uniform costs)");
-            o.search = search == "astar" ? planning::SearchAlgorithm::kAStar
-                       : search == "jps" ? planning::SearchAlgorithm::kJumpPoint
-                                         : planning::SearchAlgorithm::kAuto;
+            o.search = planning::ParseSearchAlgorithm(s, o.search);
             o.compare_astar = s.GetBool("compare_astar", o.compare_astar,
                                         "also run A* on every scenario: its optimality, times and the speed-up");
             return std::make_unique<MovingAiBenchmarkStage>(o);

@@ -4,6 +4,16 @@
 
 namespace mbot::planning {
 
+SearchAlgorithm ParseSearchAlgorithm(config::Section& s, SearchAlgorithm d) {
+  const char* names[] = {"auto", "astar", "jps"};
+  const std::string search =
+      s.GetChoice("search", names[static_cast<int>(d)], {"auto", "astar", "jps"},
+                  "search: jps (jump point search, uniform costs only), astar, or auto (jps when penalty_weight = 0)");
+  return search == "astar" ? SearchAlgorithm::kAStar
+         : search == "jps" ? SearchAlgorithm::kJumpPoint
+                           : SearchAlgorithm::kAuto;
+}
+
 AStarOptions ParseAStarOptions(config::Section& s, const AStarOptions& d) {
   AStarOptions o = d;
   o.robot_radius_m = s.GetDouble("robot_radius_m", d.robot_radius_m,
@@ -27,13 +37,7 @@ AStarOptions ParseAStarOptions(config::Section& s, const AStarOptions& d) {
       s.GetChoice("prune", names[static_cast<int>(d.prune)], {"none", "collinear", "line_of_sight"},
                   "waypoints kept: every cell, heading changes only, or line-of-sight shortcuts");
   o.prune = prune == "none" ? PruneMode::kNone : prune == "collinear" ? PruneMode::kCollinear : PruneMode::kLineOfSight;
-  const char* searches[] = {"auto", "astar", "jps"};
-  const std::string search =
-      s.GetChoice("search", searches[static_cast<int>(d.search)], {"auto", "astar", "jps"},
-                  "search: jps (jump point search, uniform costs only), astar, or auto (jps when penalty_weight = 0)");
-  o.search = search == "astar" ? SearchAlgorithm::kAStar
-             : search == "jps" ? SearchAlgorithm::kJumpPoint
-                               : SearchAlgorithm::kAuto;
+  o.search = ParseSearchAlgorithm(s, d.search);
   if (o.search == SearchAlgorithm::kJumpPoint && o.penalty_weight > 0.0 && o.penalty_range_m > 0.0) {
     s.Fail("search", "jps needs uniform step costs: set penalty_weight = 0 (or search = auto)");
   }

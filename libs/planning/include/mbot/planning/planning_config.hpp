@@ -16,6 +16,8 @@ namespace mbot::planning {
 // Keys robot_radius_m, ease_start_m, ease_step_m, ease_max_m, penalty_range_m, penalty_weight,
 // penalty_exponent, node_budget, prune. Throws config::ConfigError naming section and key.
 AStarOptions ParseAStarOptions(config::Section& section, const AStarOptions& defaults = {});
+// Key search (auto | astar | jps), on its own for stages that fix the other planner options.
+SearchAlgorithm ParseSearchAlgorithm(config::Section& section, SearchAlgorithm def = SearchAlgorithm::kAuto);
 // Keys unknown_is_obstacle, occupied_threshold.
 ObstacleDistanceOptions ParseObstacleDistanceOptions(config::Section& section,
                                                      const ObstacleDistanceOptions& defaults = {});
