@@ -12,6 +12,7 @@
 #include "../regression/run_config.hpp"
 #include "mbot/drivers/source_options.hpp"
 #include "mbot/vision/apriltag_detector.hpp"
+#include "../vision/render_tags.hpp"
 
 namespace mbot::app {
 namespace {
@@ -29,17 +30,9 @@ struct Truth {
 cv::Mat Render(const std::vector<Truth>& tags) {
   cv::Mat frame(480, 640, CV_8UC1, cv::Scalar(128));
   for (const Truth& tag : tags) {
-    const cv::Mat texture = vision::TagImage("tag36h11", tag.id, 20);
     cv::Matx33d R;
     cv::Rodrigues(tag.rvec, R);
-    const double s = kTagSize / 160.0, half = texture.cols / 2.0;
-    const cv::Matx33d S(s, 0, -half * s, 0, s, -half * s, 0, 0, 1);
-    const cv::Matx33d Rt(R(0, 0), R(0, 1), tag.t[0], R(1, 0), R(1, 1), tag.t[1], R(2, 0), R(2, 1), tag.t[2]);
-    cv::Mat warped, mask;
-    cv::warpPerspective(texture, warped, cv::Mat(kK * Rt * S), frame.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-                        cv::Scalar(128));
-    cv::warpPerspective(cv::Mat(texture.size(), CV_8UC1, cv::Scalar(255)), mask, cv::Mat(kK * Rt * S), frame.size());
-    warped.copyTo(frame, mask);
+    vision::test::DrawTag(&frame, kK, kTagSize, tag.id, R, tag.t);
   }
   return frame;
 }

@@ -9,23 +9,15 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "render_tags.hpp"
+
 namespace mbot::vision {
 namespace {
 
 const cv::Matx33d kK(530, 0, 320, 0, 530, 240, 0, 0, 1);
 constexpr double kTagSize = 0.054;
 
-// tag36h11 `id` with its tag frame at (R, t) in the camera frame, on a grey background.
-cv::Mat RenderTag(int id, const cv::Matx33d& R, const cv::Vec3d& t) {
-  const cv::Mat texture = TagImage("tag36h11", id, 20);
-  const double s = kTagSize / 160.0, half = texture.cols / 2.0;
-  const cv::Matx33d S(s, 0, -half * s, 0, s, -half * s, 0, 0, 1);
-  const cv::Matx33d Rt(R(0, 0), R(0, 1), t[0], R(1, 0), R(1, 1), t[1], R(2, 0), R(2, 1), t[2]);
-  cv::Mat frame;
-  cv::warpPerspective(texture, frame, cv::Mat(kK * Rt * S), cv::Size(640, 480), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-                      cv::Scalar(128));
-  return frame;
-}
+cv::Mat RenderTag(int id, const cv::Matx33d& R, const cv::Vec3d& t) { return test::RenderTag(kK, kTagSize, id, R, t); }
 
 cv::Matx33d FromQuaternion(const std::array<double, 4>& q) {
   const double w = q[0], x = q[1], y = q[2], z = q[3];

@@ -5,25 +5,16 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "render_tags.hpp"
+
 namespace mbot::vision {
 namespace {
 
 const cv::Matx33d kK(600, 0, 320, 0, 600, 240, 0, 0, 1);
 constexpr double kTagSize = 0.10;  // the black square's side [m]
 
-// tag36h11 id 3 (10 cells with the white border, 20 px a cell; the black square 8 cells = kTagSize)
-// seen by the pinhole camera kK at the pose (R, t) of the tag frame (x right, y down the printed
-// tag, z into it) in the camera frame, on a grey background.
-cv::Mat RenderTag(const cv::Matx33d& R, const cv::Vec3d& t) {
-  const cv::Mat texture = TagImage("tag36h11", 3, 20);
-  const double s = kTagSize / 160.0, half = texture.cols / 2.0;
-  const cv::Matx33d S(s, 0, -half * s, 0, s, -half * s, 0, 0, 1);
-  const cv::Matx33d Rt(R(0, 0), R(0, 1), t[0], R(1, 0), R(1, 1), t[1], R(2, 0), R(2, 1), t[2]);
-  cv::Mat frame;
-  cv::warpPerspective(texture, frame, cv::Mat(kK * Rt * S), cv::Size(640, 480), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-                      cv::Scalar(128));
-  return frame;
-}
+// tag36h11 id 3 seen by kK at the pose (R, t) of its tag frame in the camera frame.
+cv::Mat RenderTag(const cv::Matx33d& R, const cv::Vec3d& t) { return test::RenderTag(kK, kTagSize, 3, R, t); }
 
 double AngleDeg(const cv::Matx33d& a, const cv::Matx33d& b) {
   cv::Vec3d r;
