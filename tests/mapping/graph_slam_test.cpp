@@ -10,6 +10,7 @@
 #include "mbot/mapping/graph_slam.hpp"
 #include "mbot/mapping/pose_graph.hpp"
 #include "mbot/mapping/scan_matching.hpp"
+#include "room_fixture.hpp"
 
 namespace mbot::mapping {
 namespace {
@@ -32,20 +33,7 @@ OccupancyGrid Building() {
 }
 
 // What a 360-beam lidar (1° apart, as the Intel log's SICK) at `truth` sees in `world`, robot frame.
-std::vector<ScanRay> ScanAt(const OccupancyGrid& world, const Pose2D& truth) {
-  std::vector<ScanRay> rays;
-  for (int k = 0; k < 360; ++k) {
-    const double a = truth.theta + k * M_PI / 180, la = a - truth.theta;
-    double r = 0;
-    int cx, cy;
-    do {
-      r += 0.005;
-      world.WorldToCell(truth.x + r * std::cos(a), truth.y + r * std::sin(a), &cx, &cy);
-    } while (world.at(cx, cy) <= 0);
-    rays.push_back(ScanRay{0, 0, float(r * std::cos(la)), float(r * std::sin(la)), true});
-  }
-  return rays;
-}
+std::vector<ScanRay> ScanAt(const OccupancyGrid& world, const Pose2D& truth) { return MarchScan(world, truth, 360); }
 
 TEST(MatchGrid, LevelsBoundEveryBlock) {
   const OccupancyGrid world = Building();

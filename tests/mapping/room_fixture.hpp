@@ -10,11 +10,12 @@
 
 namespace mbot::mapping {
 
-// The scan a 180-beam lidar at `truth` sees in `map` (ray-marched), in the robot's frame.
-inline std::vector<ScanRay> MarchScan(const OccupancyGrid& map, const motion::Pose2D& truth) {
+// The scan a lidar of `beams` evenly spaced beams at `truth` sees in `map` (ray-marched), in the
+// robot's frame.
+inline std::vector<ScanRay> MarchScan(const OccupancyGrid& map, const motion::Pose2D& truth, int beams = 180) {
   std::vector<ScanRay> rays;
-  for (int k = 0; k < 180; ++k) {
-    const double a = truth.theta + k * 2 * M_PI / 180;
+  for (int k = 0; k < beams; ++k) {
+    const double a = truth.theta + k * 2 * M_PI / beams;
     double r = 0;
     int cx, cy;
     do {
