@@ -64,7 +64,7 @@ Pose2D TruthAt(const std::vector<Event>& events, int64_t t_us) {
 }
 
 TEST(SimRobot, DrivesStraightAtTheCommandedSpeed) {
-  const World world = Box(3.0);
+  World world = Box(3.0);
   const Pose2D start{-1.5, 0.2, 0.1};
   SimRobot robot(world, SimRobotOptions{}, start, 1);
   const auto events = Drive(robot, 0.2, 0.0, 5.0);
@@ -83,7 +83,7 @@ TEST(SimRobot, DrivesStraightAtTheCommandedSpeed) {
 }
 
 TEST(SimRobot, TurnsInPlace) {
-  const World world = Box(2.0);
+  World world = Box(2.0);
   SimRobot robot(world, SimRobotOptions{}, {0, 0, 0}, 2);
   const auto events = Drive(robot, 0.0, 1.0, 4.0);
   // Unwrapped true heading from the 100 Hz ground truth; steady yaw rate within 5 % of 1 rad/s.
@@ -108,7 +108,7 @@ TEST(SimRobot, TurnsInPlace) {
 }
 
 TEST(SimRobot, EncoderTicksFollowTheWheelRotation) {
-  const World world = Box(3.0);
+  World world = Box(3.0);
   SimRobotOptions o;
   o.slip_stddev = 0.0;  // ground motion = rotation · r
   SimRobot robot(world, o, {-1.5, 0, 0}, 3);
@@ -149,7 +149,7 @@ TEST(SimRobot, EncoderTicksFollowTheWheelRotation) {
 }
 
 TEST(SimRobot, LidarScanMatchesRaycastAtRest) {
-  const World world = Box(2.0);
+  World world = Box(2.0);
   SimRobotOptions o;
   o.lidar.range_noise_m = 0.0;
   o.lidar.dropout = 0.0;
@@ -186,7 +186,7 @@ TEST(SimRobot, LidarScanMatchesRaycastAtRest) {
 }
 
 TEST(SimRobot, LidarBeamsAreTakenAtTheirOwnTimesWhileMoving) {
-  const World world = Box(2.0);
+  World world = Box(2.0);
   SimRobotOptions o;
   o.lidar.range_noise_m = 0.0;
   o.lidar.dropout = 0.0;
@@ -206,7 +206,7 @@ TEST(SimRobot, LidarBeamsAreTakenAtTheirOwnTimesWhileMoving) {
 }
 
 TEST(SimRobot, StopsAtAWallAndCountsEachContactOnce) {
-  const World world = Box(1.0);
+  World world = Box(1.0);
   SimRobotOptions o;
   SimRobot robot(world, o, {0, 0, 0}, 6);
   auto events = Drive(robot, 0.3, 0.0, 6.0);
@@ -234,7 +234,7 @@ TEST(SimRobot, StopsAtAWallAndCountsEachContactOnce) {
 }
 
 TEST(SimRobot, RejectsAStartInAWall) {
-  const World world = Box(1.0);
+  World world = Box(1.0);
   EXPECT_THROW(SimRobot(world, SimRobotOptions{}, {0.95, 0, 0}, 1), std::invalid_argument);
   SimRobotOptions bad;
   bad.lidar.beams = 0;
@@ -267,7 +267,7 @@ std::string Fingerprint(const Event& e) {
 }
 
 std::vector<std::string> Stream(uint64_t seed) {
-  const World world = Box(1.5);
+  World world = Box(1.5);
   SimRobot robot(world, SimRobotOptions{}, {0, 0, 0}, seed);
   std::vector<Event> events = Drive(robot, 0.3, 0.5, 1.0);
   robot.Command(0.1, -1.0);

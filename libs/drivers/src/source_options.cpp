@@ -303,6 +303,9 @@ const char* ToString(EventKind kind) {
     case EventKind::kParticles: return "particles";
     case EventKind::kTagSightings: return "tag sightings";
     case EventKind::kCameraFrame: return "camera frame";
+    case EventKind::kForkliftCommand: return "forklift command";
+    case EventKind::kForkliftStatus: return "forklift status";
+    case EventKind::kCrates: return "crates";
     case EventKind::kOther: return "other";
   }
   return "?";

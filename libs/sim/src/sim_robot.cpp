@@ -49,7 +49,7 @@ Event MakeEvent(int64_t t_us, const char* channel, EventKind kind, Payload paylo
 }  // namespace
 
 struct SimRobot::Impl {
-  Impl(const World& w, const SimRobotOptions& opt, const Pose2D& start, uint64_t seed)
+  Impl(World& w, const SimRobotOptions& opt, const Pose2D& start, uint64_t seed)
       : world(w),
         o(opt),
         controller(opt.controller, opt.geometry, opt.firmware_calibration),
@@ -101,6 +101,11 @@ struct SimRobot::Impl {
     next_gt = gt_us;
     next_slip = slip_us;
     next_rev_end = lidar_us;
+    if (o.forklift.enabled) {
+      fork = std::make_unique<Forklift>(&world, o.forklift);
+      fork_us = PeriodUs(1.0 / o.forklift.status_rate_hz, "the forklift's status rate");
+      next_fork = 0;  // a status, and the crates, at the start
+    }
     rad_per_tick = o.geometry.RadPerTick();
 
     const int n = o.lidar.beams;
@@ -166,28 +171,56 @@ struct SimRobot::Impl {
                 motion::WrapAngle(pose.theta + dth)};
     const bool moves = next.x != pose.x || next.y != pose.y;
     // A step that brings the footprint into a wall, or deeper, is blocked; one that touches but
-    // moves away (or turns in place) is not, so a robot that touched a wall can back off.
-    if (moves && world.Collides(next.x, next.y, o.footprint_radius_m) &&
-        world.ClearanceAt(next.x, next.y) < world.ClearanceAt(pose.x, pose.y) + 1e-9) {
+    // moves away (or turns in place) is not, so a robot that touched a wall can back off. The
+    // crate on the tines is under the robot's front, not in its way.
+    const int ignore = fork ? fork->engaged() : -1;
+    bool blocked = moves && world.Collides(next.x, next.y, o.footprint_radius_m, ignore) &&
+                   world.ClearanceAt(next.x, next.y, ignore) < world.ClearanceAt(pose.x, pose.y, ignore) + 1e-9;
+    bool hit = blocked;
+    if (!blocked && fork) {
+      const ForkContact c = fork->Check(pose, next);
+      blocked = c != ForkContact::kFree;
+      hit = c == ForkContact::kHit;
+    }
+    if (blocked) {
       // Blocked: the robot stays put and its wheels stall (the encoders stop with them).
       w_l = w_r = 0.0;
       body_rate = body_v = 0.0;
-      if (!contact) {
+      if (hit && !contact) {
         contact = true;
         ++collisions;
         out->push_back(MakeEvent(t1, sim_channel::kCollision, EventKind::kCollision, pose));
       }
-      return;
+    } else {
+      w_l = wl;
+      w_r = wr;
+      angle_l += rot_l;
+      angle_r += rot_r;
+      pose = next;
+      body_v = d / h;
+      body_rate = dth / h;
+      distance += std::abs(chord);
+      if (contact && !world.Collides(pose.x, pose.y, o.footprint_radius_m + o.contact_release_m, ignore) &&
+          (!fork || fork->Check(pose, pose) == ForkContact::kFree))
+        contact = false;
     }
-    w_l = wl;
-    w_r = wr;
-    angle_l += rot_l;
-    angle_r += rot_r;
-    pose = next;
-    body_v = d / h;
-    body_rate = dth / h;
-    distance += std::abs(chord);
-    if (contact && !world.Collides(pose.x, pose.y, o.footprint_radius_m + o.contact_release_m)) contact = false;
+    if (fork && fork->Step(h, pose)) crates_changed = true;
+  }
+
+  drivers::CrateStates Crates() const {
+    drivers::CrateStates all;
+    for (const Crate& c : world.crates())
+      all.crates.push_back({c.id, c.pose, c.z_m, c.carried, c.on_id, c.fell, c.lifted});
+    return all;
+  }
+
+  void PublishForkliftStatus(std::vector<Event>* out) {
+    drivers::ForkliftStatus st;
+    st.height_m = fork->height_m();
+    st.target_m = fork->target_m();
+    st.crate_id = fork->engaged() >= 0 ? world.crates()[fork->engaged()].id : -1;
+    st.carrying = fork->carrying();
+    out->push_back(MakeEvent(now, sim_channel::kForkliftStatus, EventKind::kForkliftStatus, st));
   }
 
   // Beams whose time has come by t1, each cast from the pose interpolated at its own time.
@@ -285,11 +318,22 @@ struct SimRobot::Impl {
         DrawSlip();
         next_slip += slip_us;
       }
+      if (fork && (crates_changed || now >= next_fork)) {
+        if (crates_changed || next_fork == 0)
+          out->push_back(MakeEvent(now, sim_channel::kCrates, EventKind::kCrates, Crates()));
+        PublishForkliftStatus(out);
+        if (now >= next_fork) next_fork = (now / fork_us + 1) * fork_us;
+        crates_changed = false;
+      }
     }
   }
 
-  const World& world;
+  World& world;
   SimRobotOptions o;
+  std::unique_ptr<Forklift> fork;  // with options.forklift.enabled
+  int64_t fork_us = 0, next_fork = 0;
+  bool crates_changed = false;
+  int fork_clamped = 0;
   motion::WheelSpeedController controller;
   motion::Gyrodometry odometry;  // the firmware's
   std::mt19937_64 slip_rng, imu_rng, lidar_rng;
@@ -325,7 +369,7 @@ struct SimRobot::Impl {
   LidarScan scan;
 };
 
-SimRobot::SimRobot(const World& world, const SimRobotOptions& options, const motion::Pose2D& start, uint64_t seed)
+SimRobot::SimRobot(World& world, const SimRobotOptions& options, const motion::Pose2D& start, uint64_t seed)
     : impl_(std::make_unique<Impl>(world, options, start, seed)) {
   impl_->Init();
 }
@@ -337,6 +381,15 @@ void SimRobot::Command(double v_m_s, double w_rad_s) {
   impl_->cmd_w = std::isfinite(w_rad_s) ? w_rad_s : 0.0;
   impl_->last_command_us = impl_->now;
 }
+
+bool SimRobot::CommandFork(double height_m) {
+  if (!impl_->fork) return false;
+  if (impl_->fork->Command(height_m)) ++impl_->fork_clamped;
+  return true;
+}
+
+const Forklift* SimRobot::forklift() const { return impl_->fork.get(); }
+int SimRobot::forklift_commands_clamped() const { return impl_->fork_clamped; }
 
 void SimRobot::AdvanceTo(int64_t t_us, std::vector<Event>* out) { impl_->AdvanceTo(t_us, out); }
 

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "mbot/common/log.hpp"
 #include "mbot/common/strings.hpp"
 
 namespace mbot::sim {
@@ -32,7 +33,7 @@ motion::Pose2D StartPose(const SourceOptions& options, const SimSourceOptions& s
   return starts.front();
 }
 
-std::unique_ptr<SimRobot> MakeRobot(const SourceOptions& options, const SimSourceOptions& sim, const World& world,
+std::unique_ptr<SimRobot> MakeRobot(const SourceOptions& options, const SimSourceOptions& sim, World& world,
                                     const motion::Pose2D& start) {
   try {
     return std::make_unique<SimRobot>(world, sim.robot, start, options.seed);
@@ -98,15 +99,32 @@ std::vector<std::pair<std::string, std::string>> SimSource::Details() const {
   std::ostringstream start, duration;
   start << start_.x << ", " << start_.y << ", " << start_.theta * 180.0 / M_PI << " deg";
   duration << duration_us_ * 1e-6 << " s";
-  return {{"world", world_.name().empty() ? path_ : world_.name()},
-          {"world file", path_},
-          {"start", start.str()},
-          {"seed", std::to_string(seed_)},
-          {"duration", duration.str()},
-          {"collisions", std::to_string(robot_->collisions())}};
+  std::vector<std::pair<std::string, std::string>> d = {{"world", world_.name().empty() ? path_ : world_.name()},
+                                                        {"world file", path_},
+                                                        {"start", start.str()},
+                                                        {"seed", std::to_string(seed_)},
+                                                        {"duration", duration.str()},
+                                                        {"collisions", std::to_string(robot_->collisions())}};
+  if (robot_->forklift()) {
+    d.push_back({"crates", std::to_string(world_.crates().size())});
+    d.push_back({"forklift commands clamped", std::to_string(robot_->forklift_commands_clamped())});
+  }
+  return d;
 }
 
 void SimSource::Send(const Event& event) {
+  if (event.kind == EventKind::kForkliftCommand) {
+    const auto* cmd = std::get_if<drivers::ForkliftCommand>(&event.payload);
+    if (!cmd || !robot_->forklift()) return;
+    const int before = robot_->forklift_commands_clamped();
+    robot_->CommandFork(cmd->height_m);
+    if (robot_->forklift_commands_clamped() > before && before < 10) {
+      mbot::log::Warn("sim: forklift command " + Significant(cmd->height_m, 4) + " m on " + event.channel +
+                      " is outside [" + Significant(robot_->forklift()->options().min_height_m, 3) + ", " +
+                      Significant(robot_->forklift()->options().max_height_m, 3) + "] m: clamped");
+    }
+    return;
+  }
   if (event.kind != EventKind::kMotorCommand) return;
   const auto* cmd = std::get_if<MotorCommand>(&event.payload);
   if (cmd && cmd->kind == MotorCommand::Kind::kVelocity) robot_->Command(cmd->velocity.v_m_s, cmd->velocity.w_rad_s);

@@ -89,6 +89,38 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& wo
   l.range_noise_m =
       s.GetDouble("lidar_range_noise_m", l.range_noise_m, doc("lidar range noise, standard deviation [m]"), 0.0, 1.0);
   l.dropout = s.GetDouble("lidar_dropout", l.dropout, doc("probability that a lidar beam gives no return"), 0.0, 1.0);
+
+  ForkliftOptions& f = r.forklift;
+  f.enabled = s.GetBool("forklift", f.enabled,
+                        doc("the robot has a forklift (Heavy Lift): tines at its front that lift crates, commanded "
+                            "on MBOT_FORKLIFT_CMD"));
+  f.tip_x_m = s.GetDouble("fork_tip_x_m", f.tip_x_m, doc("forklift: the tines' tips ahead of the robot's centre [m]"),
+                          0.01, 1.0);
+  f.tine_length_m = s.GetDouble("fork_tine_length_m", f.tine_length_m,
+                                doc("forklift: how far a crate slides onto the tines [m]"), 0.005, 1.0);
+  f.min_height_m = s.GetDouble("fork_min_height_m", f.min_height_m, doc("forklift: lowest tine height [m]"), 0.0, 1.0);
+  f.max_height_m = s.GetDouble("fork_max_height_m", f.max_height_m, doc("forklift: highest tine height [m]"), 0.0, 1.0);
+  f.speed_m_s = s.GetDouble("fork_speed_m_s", f.speed_m_s, doc("forklift: how fast the tines move [m/s]"), 0.001, 1.0);
+  f.slot_m = s.GetDouble("fork_slot_m", f.slot_m,
+                         doc("forklift: height of the slot in a crate's base that the tines enter [m]"), 0.001, 0.5);
+  f.engage_depth_m = s.GetDouble("fork_engage_depth_m", f.engage_depth_m,
+                                 doc("forklift: the tips this far inside a crate's face engage it [m]"), 0.001, 1.0);
+  f.engage_lateral_m =
+      s.GetDouble("fork_engage_lateral_m", f.engage_lateral_m,
+                  doc("forklift: the robot's centre line within this of the crate's centre to enter it [m]"), 0.0, 0.5);
+  f.engage_heading_deg =
+      s.GetDouble("fork_engage_heading_deg", f.engage_heading_deg,
+                  doc("forklift: the robot square to the crate's face within this to enter it [deg]"), 0.0, 44.0);
+  f.stack_tolerance_m =
+      s.GetDouble("fork_stack_tolerance_m", f.stack_tolerance_m,
+                  doc("forklift: a crate set down with its centre within this of the one below is stacked; farther "
+                      "off, it falls [m]"),
+                  0.0, 0.5);
+  f.status_rate_hz = s.GetDouble("fork_status_rate_hz", f.status_rate_hz,
+                                 doc("forklift: rate of MBOT_FORKLIFT_STATUS [Hz]"), 0.1, 1000.0);
+  if (f.max_height_m <= f.min_height_m) s.Fail("fork_max_height_m", "must be above fork_min_height_m");
+  if (f.tine_length_m > f.tip_x_m) s.Fail("fork_tine_length_m", "must not exceed fork_tip_x_m");
+  if (f.engage_depth_m >= f.tine_length_m) s.Fail("fork_engage_depth_m", "must be below fork_tine_length_m");
   return o;
 }
 

@@ -581,39 +581,47 @@ double Crate::RayDistance(double x, double y, double angle_rad) const {
   return t0;
 }
 
+// Overlap tests use points every 2 mm round each footprint's edge, and its centre: a wall (at least
+// 1 mm thick, and a capsule) or another box cannot lie across an edge between two of them unseen,
+// and one box wholly inside another shows by its centre.
+std::vector<std::pair<double, double>> Crate::Outline(double step_m) const {
+  const double c = std::cos(pose.theta), s = std::sin(pose.theta);
+  std::vector<std::pair<double, double>> points = {{pose.x, pose.y}};
+  const double hw = 0.5 * width_m, hd = 0.5 * depth_m;
+  const double corners[5][2] = {{-hw, -hd}, {hw, -hd}, {hw, hd}, {-hw, hd}, {-hw, -hd}};
+  for (int e = 0; e < 4; ++e) {
+    const double ex = corners[e + 1][0] - corners[e][0], ey = corners[e + 1][1] - corners[e][1];
+    const int n = std::max(1, static_cast<int>(std::ceil(std::hypot(ex, ey) / step_m)));
+    for (int i = 0; i < n; ++i) {
+      const double u = corners[e][0] + ex * i / n, v = corners[e][1] + ey * i / n;
+      points.emplace_back(pose.x + c * u - s * v, pose.y + s * u + c * v);
+    }
+  }
+  return points;
+}
+
+bool Crate::Overlaps(const Crate& other) const {
+  for (const auto& [x, y] : Outline(0.002)) {
+    if (other.DistanceTo(x, y) <= 0.0) return true;
+  }
+  for (const auto& [x, y] : other.Outline(0.002)) {
+    if (DistanceTo(x, y) <= 0.0) return true;
+  }
+  return false;
+}
+
 void World::AddCrate(const Crate& crate) {
   const std::string which = "crate " + std::to_string(crate.id);
   if (!(crate.width_m > 0 && crate.depth_m > 0 && crate.height_m > 0) || !std::isfinite(crate.pose.x) ||
       !std::isfinite(crate.pose.y) || !std::isfinite(crate.pose.theta)) {
     throw std::invalid_argument(which + ": sides must be positive and the pose finite");
   }
-  // Overlap tests on points every 2 mm round each footprint's edge, and its centre: a wall (at least
-  // 1 mm thick, and a capsule) or another box cannot lie across an edge between two of them unseen,
-  // and one box wholly inside another shows by its centre.
-  auto outline = [](const Crate& k) {
-    const double c = std::cos(k.pose.theta), s = std::sin(k.pose.theta);
-    std::vector<std::pair<double, double>> points = {{k.pose.x, k.pose.y}};
-    const double hw = 0.5 * k.width_m, hd = 0.5 * k.depth_m;
-    const double corners[5][2] = {{-hw, -hd}, {hw, -hd}, {hw, hd}, {-hw, hd}, {-hw, -hd}};
-    for (int e = 0; e < 4; ++e) {
-      const double ex = corners[e + 1][0] - corners[e][0], ey = corners[e + 1][1] - corners[e][1];
-      const int n = std::max(1, static_cast<int>(std::ceil(std::hypot(ex, ey) / 0.002)));
-      for (int i = 0; i < n; ++i) {
-        const double u = corners[e][0] + ex * i / n, v = corners[e][1] + ey * i / n;
-        points.emplace_back(k.pose.x + c * u - s * v, k.pose.y + s * u + c * v);
-      }
-    }
-    return points;
-  };
-  const auto mine = outline(crate);
+  const auto mine = crate.Outline(0.002);
   for (const auto& [x, y] : mine) {
     if (WallsClearanceAt(x, y) <= 0.0) throw std::invalid_argument(which + ": overlaps a wall or leaves the world");
   }
   for (const Crate& other : crates_) {
-    bool overlap = false;
-    for (const auto& [x, y] : mine) overlap = overlap || other.DistanceTo(x, y) <= 0.0;
-    for (const auto& [x, y] : outline(other)) overlap = overlap || crate.DistanceTo(x, y) <= 0.0;
-    if (overlap) throw std::invalid_argument(which + ": overlaps crate " + std::to_string(other.id));
+    if (crate.Overlaps(other)) throw std::invalid_argument(which + ": overlaps crate " + std::to_string(other.id));
   }
   crates_.push_back(crate);
 }
@@ -622,7 +630,9 @@ double World::Raycast(double x, double y, double angle_rad, double max_range_m) 
   if (!index_ || !std::isfinite(x) || !std::isfinite(y)) return 0.0;
   double range = is_grid_world() ? RaycastGrid(truth_, x, y, angle_rad, max_range_m)
                                  : RaycastArena(*index_, x, y, angle_rad, max_range_m);
-  for (const Crate& crate : crates_) range = std::min(range, crate.RayDistance(x, y, angle_rad));
+  for (const Crate& crate : crates_) {
+    if (crate.OnFloor()) range = std::min(range, crate.RayDistance(x, y, angle_rad));
+  }
   return range;
 }
 
@@ -635,15 +645,24 @@ double World::WallsClearanceAt(double x, double y) const {
   return GridClearance(truth_, *index_, x, y);
 }
 
-double World::ClearanceAt(double x, double y) const {
+double World::ClearanceAt(double x, double y) const { return ClearanceAt(x, y, -1); }
+
+double World::ClearanceAt(double x, double y, int ignore_crate) const {
   double clearance = WallsClearanceAt(x, y);
-  for (const Crate& crate : crates_) clearance = std::min(clearance, crate.DistanceTo(x, y));
+  for (size_t i = 0; i < crates_.size(); ++i) {
+    if (crates_[i].OnFloor() && static_cast<int>(i) != ignore_crate)
+      clearance = std::min(clearance, crates_[i].DistanceTo(x, y));
+  }
   return clearance;
 }
 
-bool World::Collides(double x, double y, double radius_m) const {
-  for (const Crate& crate : crates_) {
-    if (crate.DistanceTo(x, y) <= std::max(radius_m, 0.0)) return true;
+bool World::Collides(double x, double y, double radius_m) const { return Collides(x, y, radius_m, -1); }
+
+bool World::Collides(double x, double y, double radius_m, int ignore_crate) const {
+  for (size_t i = 0; i < crates_.size(); ++i) {
+    if (crates_[i].OnFloor() && static_cast<int>(i) != ignore_crate &&
+        crates_[i].DistanceTo(x, y) <= std::max(radius_m, 0.0))
+      return true;
   }
   return WallsCollide(x, y, radius_m);
 }

@@ -125,33 +125,65 @@ struct CameraFrame {
 };
 
 enum class EventKind {
-  kLidar,          // LidarScan
-  kOdometry,       // Pose2D, the robot's own dead-reckoning
-  kEncoders,       // EncoderTicks
-  kImu,            // Imu
-  kMotorCommand,   // MotorCommand
-  kGroundTruth,    // Pose2D, external measurement (motion capture)
-  kReferencePose,  // Pose2D from another estimator (staff SLAM, corrected CARMEN poses)
-  kMap,            // shared_ptr<const OccupancyGrid>
-  kPlanRequest,    // PlanRequest, on the channel named after its map
-  kWheelSpeed,     // WheelSpeeds measured by the robot (not a command)
-  kMotorSample,    // WheelSample from a calibration file
-  kCollision,      // Pose2D: the true pose at which the simulated robot touched a wall
-  kPoseEstimate,   // Pose2D: the stack's own pose estimate (SLAM / localization output)
-  kPath,           // Path: the planned path the controller follows
-  kSlamStatus,     // mapping::SlamStatus: what SLAM's pose is worth (SLAM_STATUS)
-  kMissionStatus,  // mission::MissionStatus: the state of the robot's task (exploration, competition event)
-  kParticles,      // Particles: the localization's samples
-  kTagSightings,   // TagSightings: AprilTags seen in one camera frame (MBOT_APRILTAG_ARRAY)
-  kCameraFrame,    // CameraFrame: an image from a camera or an image folder
-  kOther,          // recognised but not used by the pipeline (time sync, resets, legacy particles …)
+  kLidar,            // LidarScan
+  kOdometry,         // Pose2D, the robot's own dead-reckoning
+  kEncoders,         // EncoderTicks
+  kImu,              // Imu
+  kMotorCommand,     // MotorCommand
+  kGroundTruth,      // Pose2D, external measurement (motion capture)
+  kReferencePose,    // Pose2D from another estimator (staff SLAM, corrected CARMEN poses)
+  kMap,              // shared_ptr<const OccupancyGrid>
+  kPlanRequest,      // PlanRequest, on the channel named after its map
+  kWheelSpeed,       // WheelSpeeds measured by the robot (not a command)
+  kMotorSample,      // WheelSample from a calibration file
+  kCollision,        // Pose2D: the true pose at which the simulated robot touched a wall
+  kPoseEstimate,     // Pose2D: the stack's own pose estimate (SLAM / localization output)
+  kPath,             // Path: the planned path the controller follows
+  kSlamStatus,       // mapping::SlamStatus: what SLAM's pose is worth (SLAM_STATUS)
+  kMissionStatus,    // mission::MissionStatus: the state of the robot's task (exploration, competition event)
+  kParticles,        // Particles: the localization's samples
+  kTagSightings,     // TagSightings: AprilTags seen in one camera frame (MBOT_APRILTAG_ARRAY)
+  kCameraFrame,      // CameraFrame: an image from a camera or an image folder
+  kForkliftCommand,  // ForkliftCommand: the height the forklift's tines should go to (MBOT_FORKLIFT_CMD)
+  kForkliftStatus,   // ForkliftStatus: where the tines are and what they hold (MBOT_FORKLIFT_STATUS)
+  kCrates,           // CrateStates: where the simulator's crates are (SIM_CRATES; the referee's truth)
+  kOther,            // recognised but not used by the pipeline (time sync, resets, legacy particles …)
+};
+// The forklift (Heavy Lift): a target height for the tines [m above the floor].
+struct ForkliftCommand {
+  double height_m = 0.0;
+};
+
+// What the forklift reports: the tines' height and target, and the crate on them (its tag id, -1
+// when none; carrying once it is lifted off what it stood on).
+struct ForkliftStatus {
+  double height_m = 0.0;
+  double target_m = 0.0;
+  int crate_id = -1;
+  bool carrying = false;
+};
+
+// The simulator's crates as they are (world frame): pose, the underside's height, and what happened
+// to them — on the fork, stacked on another (its id), fallen, ever lifted clear of the floor.
+struct CrateState {
+  int id = 0;
+  motion::Pose2D pose;
+  double z_m = 0.0;
+  bool carried = false;
+  int on_id = -1;
+  bool fell = false;
+  bool lifted = false;
+};
+struct CrateStates {
+  std::vector<CrateState> crates;
 };
 
 const char* ToString(EventKind kind);
 
 using Payload = std::variant<std::monostate, LidarScan, motion::Pose2D, EncoderTicks, Imu, MotorCommand, WheelSpeeds,
                              std::shared_ptr<const mapping::OccupancyGrid>, PlanRequest, WheelSample, Path,
-                             mapping::SlamStatus, mission::MissionStatus, Particles, TagSightings, CameraFrame>;
+                             mapping::SlamStatus, mission::MissionStatus, Particles, TagSightings, CameraFrame,
+                             ForkliftCommand, ForkliftStatus, CrateStates>;
 
 struct Event {
   int64_t t_us = 0;      // event (reception / log) time; the order of the stream

@@ -16,6 +16,10 @@
 //   LIDAR          kLidar       one revolution; angles, per-beam times      (lidar rate)
 //   TRUE_POSE      kGroundTruth the true pose                              (ground-truth rate)
 //   SIM_COLLISION  kCollision   the true pose when a new contact begins
+// and, with a forklift (options.forklift.enabled; Heavy Lift):
+//   MBOT_FORKLIFT_STATUS kForkliftStatus  tines' height, target, the crate on them (status rate)
+//   SIM_CRATES     kCrates      every crate's pose and state, at the start and whenever one changes
+// It takes MBOT_FORKLIFT_CMD's target height through CommandFork.
 // Every event has t_us = stamp_us = simulated time. Given the same seed, a run is reproducible.
 // Frames: TRUE_POSE and SIM_COLLISION are in the world frame; MBOT_ODOMETRY starts at (0, 0, 0) like
 // a real robot's. Encoder ticks carry the geometry's encoder polarities (default +1: forward counts
@@ -29,6 +33,7 @@
 #include <vector>
 
 #include "mbot/drivers/events.hpp"
+#include "mbot/sim/forklift.hpp"
 #include "mbot/sim/world.hpp"
 #include "mbot/motion/gyrodometry.hpp"
 #include "mbot/motion/motor_model.hpp"
@@ -50,6 +55,9 @@ inline constexpr const char* kMotorVel = "MBOT_MOTOR_VEL";
 inline constexpr const char* kLidar = "LIDAR";
 inline constexpr const char* kTruePose = "TRUE_POSE";
 inline constexpr const char* kCollision = "SIM_COLLISION";
+inline constexpr const char* kForkliftStatus = "MBOT_FORKLIFT_STATUS";
+inline constexpr const char* kForkliftCommand = "MBOT_FORKLIFT_CMD";
+inline constexpr const char* kCrates = "SIM_CRATES";
 }  // namespace sim_channel
 
 struct SimLidarOptions {
@@ -91,18 +99,24 @@ struct SimRobotOptions {
   double footprint_radius_m = 0.1;
   SimLidarOptions lidar;
   SimImuOptions imu;
+  ForkliftOptions forklift;
 };
 
 class SimRobot {
  public:
-  // Keeps a reference to `world`, which must outlive the robot. The robot starts at rest at `start`
-  // (world frame) at t = 0. Throws std::invalid_argument when the start pose collides or an option
-  // is out of range.
-  SimRobot(const World& world, const SimRobotOptions& options, const motion::Pose2D& start, uint64_t seed);
+  // Keeps a reference to `world`, which must outlive the robot (its forklift moves the world's
+  // crates). The robot starts at rest at `start` (world frame) at t = 0. Throws
+  // std::invalid_argument when the start pose collides or an option is out of range.
+  SimRobot(World& world, const SimRobotOptions& options, const motion::Pose2D& start, uint64_t seed);
   ~SimRobot();
 
   // The latest velocity command (MBOT_VEL_CMD): held until the next one.
   void Command(double v_m_s, double w_rad_s);
+  // The forklift's target height (MBOT_FORKLIFT_CMD); false when the robot has no forklift. A height
+  // out of range is clamped (forklift_commands_clamped counts them).
+  bool CommandFork(double height_m);
+  const Forklift* forklift() const;  // nullptr without one
+  int forklift_commands_clamped() const;
   // Runs the simulation up to `t_us`, appending the events published meanwhile in time order.
   void AdvanceTo(int64_t t_us, std::vector<Event>* out);
 

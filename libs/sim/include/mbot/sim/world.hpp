@@ -64,11 +64,26 @@ struct Crate {
   double width_m = 0.10;  // along its own x
   double depth_m = 0.10;  // along its own y
   double height_m = 0.08;
+  // Where it is now (the forklift moves crates, libs/sim/forklift.hpp): its underside's height
+  // above the floor, on the fork or not, the crate it was set down on (-1: none), whether it fell
+  // (set down off-centre on another and tipped off), and whether it was ever lifted clear.
+  double z_m = 0.0;
+  bool carried = false;
+  int on_id = -1;
+  bool fell = false;
+  bool lifted = false;
+  // On the floor and not on the fork: what the lidar and the robot's body meet.
+  bool OnFloor() const { return !carried && z_m <= 1e-9; }
+  double top_m() const { return z_m + height_m; }
   // Distance from (x, y) to the box's footprint (0 inside or on it).
   double DistanceTo(double x, double y) const;
   // Distance along the ray from (x, y) at `angle_rad` to the footprint's boundary, 0 when (x, y) is
   // inside, +inf when the ray misses it.
   double RayDistance(double x, double y, double angle_rad) const;
+  // Points every `step_m` (at most) round the footprint's edge, and its centre (overlap tests).
+  std::vector<std::pair<double, double>> Outline(double step_m) const;
+  // True when the two footprints overlap or touch.
+  bool Overlaps(const Crate& other) const;
 };
 
 struct WorldIndex;
@@ -106,8 +121,16 @@ class World {
   const std::vector<ArenaPose>& poses() const { return poses_; }
   std::vector<motion::Pose2D> PosesLabelled(const std::string& label) const;
   const std::vector<WallSegment>& walls() const { return walls_; }
-  // Crates (Heavy Lift): Raycast, Collides and ClearanceAt see them as well as the walls.
+  // Crates (Heavy Lift): Raycast, Collides and ClearanceAt see those on the floor (Crate::OnFloor)
+  // as well as the walls; `ignore_crate` (an index into crates()) leaves one out — the crate on
+  // the robot's fork tines.
   const std::vector<Crate>& crates() const { return crates_; }
+  // Moves crate `index` (the forklift): no overlap check, the caller has made it.
+  void SetCrate(size_t index, const Crate& crate) { crates_.at(index) = crate; }
+  bool Collides(double x, double y, double radius_m, int ignore_crate) const;
+  double ClearanceAt(double x, double y, int ignore_crate) const;
+  // The distance from (x, y) to the nearest wall surface, crates left out (0 inside a wall).
+  double WallsClearanceAt(double x, double y) const;
   // Adds a crate; throws std::invalid_argument when its sides are not positive or it overlaps a wall
   // or another crate (naming its id).
   void AddCrate(const Crate& crate);
@@ -123,7 +146,6 @@ class World {
   std::vector<ArenaPose> poses_;
   std::vector<Crate> crates_;
   std::optional<CrateArea> crate_area_;
-  double WallsClearanceAt(double x, double y) const;
   bool WallsCollide(double x, double y, double radius_m) const;
   mapping::OccupancyGrid truth_;
   // Acceleration structures (bucket grid over the walls, or the grid's distance transform), built
