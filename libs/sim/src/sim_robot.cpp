@@ -57,6 +57,7 @@ struct SimRobot::Impl {
         slip_rng(Stream(seed, 1)),
         imu_rng(Stream(seed, 2)),
         lidar_rng(Stream(seed, 3)),
+        camera_rng(Stream(seed, 4)),
         pose(start) {}
 
   void Validate() const {
@@ -105,6 +106,11 @@ struct SimRobot::Impl {
       fork = std::make_unique<Forklift>(&world, o.forklift);
       fork_us = PeriodUs(1.0 / o.forklift.status_rate_hz, "the forklift's status rate");
       next_fork = 0;  // a status, and the crates, at the start
+    }
+    if (o.camera.enabled) {
+      camera = std::make_unique<SimCamera>(o.camera);
+      camera_us = PeriodUs(1.0 / o.camera.rate_hz, "the camera rate");
+      next_camera = camera_us;
     }
     rad_per_tick = o.geometry.RadPerTick();
 
@@ -290,7 +296,7 @@ struct SimRobot::Impl {
   void AdvanceTo(int64_t t_end, std::vector<Event>* out) {
     while (now < t_end) {
       const int64_t grid = (now / physics_us + 1) * physics_us;
-      const int64_t t1 = std::min({grid, next_fw, next_imu, next_gt, next_slip, next_rev_end, t_end});
+      const int64_t t1 = std::min({grid, next_fw, next_imu, next_gt, next_slip, next_rev_end, next_camera, t_end});
       const int64_t t0 = now;
       const Pose2D p0 = pose;
       Physics((t1 - t0) * 1e-6, t1, out);
@@ -318,6 +324,15 @@ struct SimRobot::Impl {
         DrawSlip();
         next_slip += slip_us;
       }
+      if (now == next_camera) {
+        const cv::Mat image = camera->Render(world, pose, camera_rng);
+        drivers::CameraFrame frame;
+        frame.width = image.cols, frame.height = image.rows;
+        frame.pixels = std::make_shared<const std::vector<uint8_t>>(image.datastart, image.dataend);
+        frame.name = "sim camera";
+        out->push_back(MakeEvent(now, sim_channel::kCamera, EventKind::kCameraFrame, std::move(frame)));
+        next_camera += camera_us;
+      }
       if (fork && (crates_changed || now >= next_fork)) {
         if (crates_changed || next_fork == 0)
           out->push_back(MakeEvent(now, sim_channel::kCrates, EventKind::kCrates, Crates()));
@@ -330,13 +345,15 @@ struct SimRobot::Impl {
 
   World& world;
   SimRobotOptions o;
-  std::unique_ptr<Forklift> fork;  // with options.forklift.enabled
+  std::unique_ptr<Forklift> fork;     // with options.forklift.enabled
+  std::unique_ptr<SimCamera> camera;  // with options.camera.enabled
+  int64_t camera_us = 0, next_camera = std::numeric_limits<int64_t>::max();
   int64_t fork_us = 0, next_fork = 0;
   bool crates_changed = false;
   int fork_clamped = 0;
   motion::WheelSpeedController controller;
   motion::Gyrodometry odometry;  // the firmware's
-  std::mt19937_64 slip_rng, imu_rng, lidar_rng;
+  std::mt19937_64 slip_rng, imu_rng, lidar_rng, camera_rng;
   std::normal_distribution<double> normal{0.0, 1.0};
   std::uniform_real_distribution<double> uniform{0.0, 1.0};
 

@@ -69,6 +69,13 @@ SimSource::SimSource(const SourceOptions& options, const SimSourceOptions& sim)
   channels_[sim_channel::kLidar] = ChannelInfo{"lidar_t", gen, EventKind::kLidar, true};
   channels_[sim_channel::kTruePose] = ChannelInfo{"pose2D_t", gen, EventKind::kGroundTruth, true};
   channels_[sim_channel::kCollision] = ChannelInfo{"pose2D_t", gen, EventKind::kCollision, true};
+  if (sim.robot.forklift.enabled) {
+    channels_[sim_channel::kForkliftStatus] =
+        ChannelInfo{"mbot_forklift_status_t", gen, EventKind::kForkliftStatus, true};
+    channels_[sim_channel::kCrates] = ChannelInfo{"crate states", gen, EventKind::kCrates, true};
+  }
+  if (sim.robot.camera.enabled)
+    channels_[sim_channel::kCamera] = ChannelInfo{"8-bit grey image", gen, EventKind::kCameraFrame, true};
 }
 
 std::optional<Event> SimSource::Next() {

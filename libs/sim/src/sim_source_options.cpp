@@ -5,6 +5,8 @@
 
 #include "mbot/common/config.hpp"
 #include "mbot/common/strings.hpp"
+#include "mbot/vision/camera_calibration.hpp"
+#include "mbot/vision/vision_config.hpp"
 
 namespace mbot::sim {
 
@@ -121,6 +123,38 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& wo
   if (f.max_height_m <= f.min_height_m) s.Fail("fork_max_height_m", "must be above fork_min_height_m");
   if (f.tine_length_m > f.tip_x_m) s.Fail("fork_tine_length_m", "must not exceed fork_tip_x_m");
   if (f.engage_depth_m >= f.tine_length_m) s.Fail("fork_engage_depth_m", "must be below fork_tine_length_m");
+
+  SimCameraOptions& c = r.camera;
+  c.enabled = s.GetBool("camera", c.enabled,
+                        doc("the robot has a camera: grey frames of the floor, walls and crates (with their tags) on "
+                            "CAMERA"));
+  const std::string calibration = s.GetPath(
+      "camera_calibration", "",
+      doc("the camera's intrinsics and image size: a camera.yaml (OpenCV's keys); empty: 640 x 480, fx = fy = 530, "
+          "centred, no distortion"));
+  if (!calibration.empty() && !s.describing()) {
+    try {
+      const vision::CalibrationResult cal = vision::ReadCameraYaml(calibration);
+      c.width = cal.image_width, c.height = cal.image_height;
+      c.intrinsics = vision::IntrinsicsFromYaml(calibration);
+    } catch (const std::exception& e) {
+      s.Fail("camera_calibration", e.what());
+    }
+  }
+  c.mount = vision::ParseCameraMount(s, c.mount);
+  c.rate_hz = s.GetDouble("camera_rate_hz", c.rate_hz, doc("camera frames per second [Hz]"), 0.1, 200.0);
+  c.tag_size_m = s.GetDouble("camera_tag_size_m", c.tag_size_m,
+                             doc("the tags printed on the crates: the black square's side [m]"), 0.005, 1.0);
+  c.wall_height_m =
+      s.GetDouble("wall_height_m", c.wall_height_m, doc("height of the walls the camera sees [m]"), 0.01, 10.0);
+  c.noise_stddev =
+      s.GetDouble("camera_noise", c.noise_stddev,
+                  doc("camera: Gaussian noise of each pixel, standard deviation [grey levels]"), 0.0, 100.0);
+  c.blur_sigma_px =
+      s.GetDouble("camera_blur_px", c.blur_sigma_px, doc("camera: Gaussian blur, sigma [pixels] (0: none)"), 0.0, 20.0);
+  c.exposure_change = s.GetDouble(
+      "camera_exposure_change", c.exposure_change,
+      doc("camera: each frame's gain is drawn uniformly from [1 - this, 1 + this] (exposure changes)"), 0.0, 0.9);
   return o;
 }
 

@@ -626,10 +626,15 @@ void World::AddCrate(const Crate& crate) {
   crates_.push_back(crate);
 }
 
-double World::Raycast(double x, double y, double angle_rad, double max_range_m) const {
+double World::RaycastWalls(double x, double y, double angle_rad, double max_range_m) const {
   if (!index_ || !std::isfinite(x) || !std::isfinite(y)) return 0.0;
-  double range = is_grid_world() ? RaycastGrid(truth_, x, y, angle_rad, max_range_m)
-                                 : RaycastArena(*index_, x, y, angle_rad, max_range_m);
+  return is_grid_world() ? RaycastGrid(truth_, x, y, angle_rad, max_range_m)
+                         : RaycastArena(*index_, x, y, angle_rad, max_range_m);
+}
+
+double World::Raycast(double x, double y, double angle_rad, double max_range_m) const {
+  double range = RaycastWalls(x, y, angle_rad, max_range_m);
+  if (range <= 0.0) return range;
   for (const Crate& crate : crates_) {
     if (crate.OnFloor()) range = std::min(range, crate.RayDistance(x, y, angle_rad));
   }

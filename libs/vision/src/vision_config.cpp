@@ -22,6 +22,18 @@ TagDetectorOptions ParseTagDetectorOptions(config::Section& s, const TagDetector
   return o;
 }
 
+CameraMount ParseCameraMount(config::Section& s, const CameraMount& d) {
+  CameraMount m;
+  const double deg = M_PI / 180.0;
+  m.x_m = s.GetDouble("camera_x_m", d.x_m, "camera on the robot: ahead of the wheel axle centre [m]", -10, 10);
+  m.y_m = s.GetDouble("camera_y_m", d.y_m, "camera on the robot: to the left [m]", -10, 10);
+  m.z_m = s.GetDouble("camera_z_m", d.z_m, "camera on the robot: above the floor [m]", -10, 10);
+  m.roll_rad = deg * s.GetDouble("camera_roll_deg", d.roll_rad / deg, "camera roll about its axis [deg]", -180, 180);
+  m.pitch_rad = deg * s.GetDouble("camera_pitch_deg", d.pitch_rad / deg, "camera tilt, down positive [deg]", -90, 90);
+  m.yaw_rad = deg * s.GetDouble("camera_yaw_deg", d.yaw_rad / deg, "camera turned left of ahead [deg]", -180, 180);
+  return m;
+}
+
 TagObserverOptions ParseTagObserverOptions(config::Section& s, const TagObserverOptions& d) {
   TagObserverOptions o = d;
   o.detector = ParseTagDetectorOptions(s, d.detector);
@@ -41,17 +53,7 @@ TagObserverOptions ParseTagObserverOptions(config::Section& s, const TagObserver
       "pose_method", d.pose_method == TagPoseMethod::kIppeSquare ? "ippe_square" : "apriltag",
       {"ippe_square", "apriltag"}, "tag pose: OpenCV's solvePnP IPPE_SQUARE or the reference library's estimator");
   o.pose_method = method == "ippe_square" ? TagPoseMethod::kIppeSquare : TagPoseMethod::kAprilTagLibrary;
-  CameraMount& m = o.mount;
-  const double deg = M_PI / 180.0;
-  m.x_m = s.GetDouble("camera_x_m", d.mount.x_m, "camera on the robot: ahead of the wheel axle centre [m]", -10, 10);
-  m.y_m = s.GetDouble("camera_y_m", d.mount.y_m, "camera on the robot: to the left [m]", -10, 10);
-  m.z_m = s.GetDouble("camera_z_m", d.mount.z_m, "camera on the robot: above the floor [m]", -10, 10);
-  m.roll_rad =
-      deg * s.GetDouble("camera_roll_deg", d.mount.roll_rad / deg, "camera roll about its axis [deg]", -180, 180);
-  m.pitch_rad =
-      deg * s.GetDouble("camera_pitch_deg", d.mount.pitch_rad / deg, "camera tilt, down positive [deg]", -90, 90);
-  m.yaw_rad =
-      deg * s.GetDouble("camera_yaw_deg", d.mount.yaw_rad / deg, "camera turned left of ahead [deg]", -180, 180);
+  o.mount = ParseCameraMount(s, d.mount);
   return o;
 }
 

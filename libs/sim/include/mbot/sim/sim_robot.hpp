@@ -19,7 +19,8 @@
 // and, with a forklift (options.forklift.enabled; Heavy Lift):
 //   MBOT_FORKLIFT_STATUS kForkliftStatus  tines' height, target, the crate on them (status rate)
 //   SIM_CRATES     kCrates      every crate's pose and state, at the start and whenever one changes
-// It takes MBOT_FORKLIFT_CMD's target height through CommandFork.
+// It takes MBOT_FORKLIFT_CMD's target height through CommandFork. With a camera (options.camera.enabled):
+//   CAMERA         kCameraFrame 8-bit grey frames of what the camera sees (SimCamera)   (camera rate)
 // Every event has t_us = stamp_us = simulated time. Given the same seed, a run is reproducible.
 // Frames: TRUE_POSE and SIM_COLLISION are in the world frame; MBOT_ODOMETRY starts at (0, 0, 0) like
 // a real robot's. Encoder ticks carry the geometry's encoder polarities (default +1: forward counts
@@ -34,6 +35,7 @@
 
 #include "mbot/drivers/events.hpp"
 #include "mbot/sim/forklift.hpp"
+#include "mbot/sim/sim_camera.hpp"
 #include "mbot/sim/world.hpp"
 #include "mbot/motion/gyrodometry.hpp"
 #include "mbot/motion/motor_model.hpp"
@@ -58,6 +60,7 @@ inline constexpr const char* kCollision = "SIM_COLLISION";
 inline constexpr const char* kForkliftStatus = "MBOT_FORKLIFT_STATUS";
 inline constexpr const char* kForkliftCommand = "MBOT_FORKLIFT_CMD";
 inline constexpr const char* kCrates = "SIM_CRATES";
+inline constexpr const char* kCamera = "CAMERA";
 }  // namespace sim_channel
 
 struct SimLidarOptions {
@@ -100,6 +103,7 @@ struct SimRobotOptions {
   SimLidarOptions lidar;
   SimImuOptions imu;
   ForkliftOptions forklift;
+  SimCameraOptions camera;
 };
 
 class SimRobot {

@@ -109,6 +109,8 @@ class World {
   // over the true map, to the first wall cell's boundary) in a grid world, where everything outside
   // the grid is wall. Thread-safe (no mutable state).
   double Raycast(double x, double y, double angle_rad, double max_range_m) const;
+  // The same against the walls only (crates left out).
+  double RaycastWalls(double x, double y, double angle_rad, double max_range_m) const;
   // True when a disc of `radius_m` centred at (x, y) overlaps or touches a wall
   // (ClearanceAt(x, y) <= radius_m), or leaves the true map's extent.
   bool Collides(double x, double y, double radius_m) const;
