@@ -16,9 +16,12 @@ using motion::Pose2D;
 
 World Arena(const std::string& crates) { return World::ParseArena("box -2 -2 2 2\n" + crates, "forklift.arena"); }
 
+// The geometry these tests work out by hand: tips 15 cm ahead, 6 cm tines.
 ForkliftOptions Enabled() {
   ForkliftOptions o;
   o.enabled = true;
+  o.tip_x_m = 0.15;
+  o.tine_length_m = 0.06;
   return o;
 }
 
@@ -190,12 +193,12 @@ TEST(Forklift, CommandsOutOfRangeAreClamped) {
 TEST(Forklift, SimRobotPublishesStatusAndCrates) {
   World w = Arena("crate 5 0.6 0 0\n");
   SimRobotOptions o;
-  o.forklift.enabled = true;
+  o.forklift.enabled = true;  // the default tines: tips 18 cm ahead
   SimRobot robot(w, o, {0.0, 0.0, 0.0}, 3);
   std::vector<Event> events;
   robot.Command(0.1, 0.0);
   int64_t t = 0;
-  while (robot.true_pose().x < 0.435 && t < 10'000'000) {  // tips 3.5 cm into the face at x = 0.55
+  while (robot.true_pose().x < 0.41 && t < 10'000'000) {  // tips 4 cm into the face at x = 0.55
     t += 20'000;
     robot.Command(0.1, 0.0);
     robot.AdvanceTo(t, &events);

@@ -65,7 +65,7 @@ TEST(SimWorld, ParseErrorsNameTheLineAndToken) {
   EXPECT_EQ(ParseError("wall 0 0 1 1 1\n"), "a.arena:1: 'wall' needs 4 numbers, got 5");
   EXPECT_EQ(ParseError("wall 0 0 1 1\nwal 0 0 1 1\n"),
             "a.arena:2: unknown statement 'wal' (known: name, resolution, thickness, wall, box, pose, crate, "
-            "crates_at_random)");
+            "crates_at_random, stack)");
   EXPECT_EQ(ParseError("wall 0 0 1 x1\n"), "a.arena:1: 'wall': 'x1' is not a number");
   EXPECT_EQ(ParseError("box 0 0 1 1e400\n"), "a.arena:1: 'box': '1e400' is not a finite number");
   EXPECT_EQ(ParseError("wall 0 0 1 nan\n"), "a.arena:1: 'wall': 'nan' is not a finite number");
@@ -313,7 +313,7 @@ TEST(SimWorld, LoadsArenaAndMapFilesAndNamesTheFileInErrors) {
   } catch (const std::runtime_error& e) {
     EXPECT_EQ(std::string(e.what()), arena_path +
                                          ":3: unknown statement 'bogus' (known: name, resolution, thickness, wall, "
-                                         "box, pose, crate, crates_at_random)");
+                                         "box, pose, crate, crates_at_random, stack)");
   }
   std::ofstream(arena_path) << "box 0 0 2 1\npose start 0.5 0.5 0\n";
   const World a = World::Load(arena_path);

@@ -10,6 +10,8 @@
 #include "mbot/drivers/map_io.hpp"
 #include "mbot/mission/mission.hpp"
 #include "mbot/mission/mission_config.hpp"
+#include "mbot/vision/tag_observer.hpp"
+#include "mbot/vision/vision_config.hpp"
 #include "report.hpp"
 #include "stages.hpp"
 
@@ -24,6 +26,8 @@ struct MissionStageOptions {
   std::string status_channel = "MISSION_STATUS";
   std::string path_channel = "CONTROLLER_PATH";  // follow: paths sent by a GUI arrive here
   std::string command_channel = "MBOT_VEL_CMD";
+  std::string fork_channel = "MBOT_FORKLIFT_CMD";  // heavy_lift: the tines' target height
+  vision::CameraMount camera;                      // heavy_lift: where the tags' camera sits on the robot
   double status_every_s = 0.0;  // also repeat the last state this often (a lossy link); 0: on change only
 };
 
@@ -44,6 +48,19 @@ class MissionStage : public Stage {
       case EventKind::kPath:
         if (ev.channel == o_.path_channel) mission_->OnPath(std::get<drivers::Path>(ev.payload).poses);
         return;
+      case EventKind::kTagSightings: {
+        std::vector<mission::TagSeen> seen;
+        for (const drivers::TagSighting& t : std::get<drivers::TagSightings>(ev.payload).tags) {
+          const vision::TagOnRobot r =
+              vision::TagInRobotFrame(o_.camera, {t.x_m, t.y_m, t.z_m}, {t.qw, t.qx, t.qy, t.qz});
+          seen.push_back({t.id, r.position[0], r.position[1], r.position[2], r.facing_rad});
+        }
+        return mission_->OnTags(ev.t_us, seen);
+      }
+      case EventKind::kForkliftStatus: {
+        const auto& f = std::get<drivers::ForkliftStatus>(ev.payload);
+        return mission_->OnForklift({f.height_m, f.target_m, f.crate_id, f.carrying});
+      }
       case EventKind::kOdometry:
         for (const mission::MissionOutput& out : mission_->OnOdometry(ev.t_us, std::get<motion::Pose2D>(ev.payload))) {
           Publish(ev.t_us, out);
@@ -66,6 +83,10 @@ class MissionStage : public Stage {
       << ",\n  \"odometry_restarts\": " << r.odometry_restarts << ",\n  \"rounds\": " << r.rounds;
     if (r.task == mission::TaskKind::kWarehouse)
       j << ",\n  \"stops\": " << r.stops << ",\n  \"stops_done\": " << r.stops_done;
+    if (r.task == mission::TaskKind::kHeavyLift) {
+      j << ",\n  \"crates\": " << r.crates << ",\n  \"crates_lifted\": " << r.crates_lifted
+        << ",\n  \"crates_set_down\": " << r.crates_set_down << ",\n  \"tag_sightings\": " << r.tag_sightings;
+    }
     if (r.task == mission::TaskKind::kExplore || o_.mission.explore_first) {
       j << ",\n  \"frontiers_left\": [";
       for (size_t i = 0; i < r.frontiers_left.size(); ++i) {
@@ -106,6 +127,9 @@ class MissionStage : public Stage {
       last_status_us_ = t_us;
     } else if (const auto* p = std::get_if<mission::PathOut>(&out)) {
       bus_->Emit(this, Event{t_us, t_us, o_.path_channel, EventKind::kPath, drivers::Path{p->poses}});
+    } else if (const auto* f = std::get_if<mission::ForkOut>(&out)) {
+      bus_->Emit(
+          this, Event{t_us, t_us, o_.fork_channel, EventKind::kForkliftCommand, drivers::ForkliftCommand{f->height_m}});
     } else {
       const auto& c = std::get<motion::VelocityCommand>(out);
       bus_->Emit(this, Event{t_us, t_us, o_.command_channel, EventKind::kMotorCommand,
@@ -133,7 +157,8 @@ class MissionStage : public Stage {
 StageType MissionStageType() {
   return {"mission",
           "the autonomy after SLAM (libs/mission): drives a circuit of waypoints, explores and returns home, makes the "
-          "Warehouse's deliveries or follows a GUI's paths; emits velocity commands, paths and states",
+          "Warehouse's deliveries, follows a GUI's paths or stacks crates by their tags (Heavy Lift); emits velocity "
+          "commands, forklift commands, paths and states",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             MissionStageOptions o;
             o.mission = mission::ParseMissionOptions(s);
@@ -141,6 +166,9 @@ StageType MissionStageType() {
             o.path_channel = s.GetString("path_channel", o.path_channel,
                                          "paths go out here; with task = follow, a GUI's paths come in here");
             o.command_channel = s.GetString("command_channel", o.command_channel, "velocity commands go out here");
+            o.fork_channel =
+                s.GetString("fork_channel", o.fork_channel, "heavy_lift: the forklift's target heights go out here");
+            o.camera = vision::ParseCameraMount(s, o.camera);
             o.status_every_s = s.GetDouble("status_every_s", o.status_every_s,
                                            "also repeat the last state this often, for a lossy link (0: only on "
                                            "change) [s]",

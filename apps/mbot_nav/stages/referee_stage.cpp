@@ -65,6 +65,17 @@ std::string ScoreJson(const sim::Score& s, const RunContext& ctx, const std::str
     }
     j << "\n  ]";
   }
+  if (s.event == sim::CompetitionEvent::kHeavyLift) {
+    j << ",\n  \"crates\": [";
+    for (size_t k = 0; k < s.crates.size(); ++k) {
+      const sim::CrateResult& c = s.crates[k];
+      j << (k ? "," : "") << "\n    {\"id\": " << c.id << ", \"on\": " << c.on_id
+        << ", \"lifted\": " << (c.lifted ? "true" : "false") << ", \"stacked\": " << (c.stacked ? "true" : "false")
+        << ", \"fell\": " << (c.fell ? "true" : "false") << ", \"final\": " << PoseJson(c.final_pose)
+        << ", \"final_z_m\": " << Num(c.final_z_m) << "}";
+    }
+    j << "\n  ]";
+  }
   j << ",\n  \"points\": {";
   for (const sim::RubricItem& i : s.items) j << JsonString(i.name) << ": " << i.points << ", ";
   j << "\"total\": " << s.total << ", \"max\": " << s.max_total << "}\n}\n";
@@ -80,9 +91,9 @@ class RefereeStage : public Stage {
     sim::World world = sim::World::Load(ctx.source_path);
     try {
       referee_ = std::make_unique<sim::Referee>(o_.referee, std::move(world), ctx.seed);
-    } catch (const std::invalid_argument& e) {  // only a Warehouse needs more than walls
-      throw std::runtime_error("referee: the world " + ctx.source_path +
-                               " has no Warehouse ('pose target' and 'pose dropoff' lines): " + e.what());
+    } catch (const std::invalid_argument& e) {  // the Warehouse and Heavy Lift need more than walls
+      throw std::runtime_error("referee: the world " + ctx.source_path + " cannot hold the " +
+                               sim::Title(o_.referee.event) + ": " + e.what());
     }
     wall0_ = std::chrono::steady_clock::now();
   }
@@ -92,6 +103,7 @@ class RefereeStage : public Stage {
     switch (ev.kind) {
       case EventKind::kGroundTruth: referee_->OnTruePose(ev.t_us, std::get<Pose2D>(ev.payload)); break;
       case EventKind::kCollision: referee_->OnCollision(); break;
+      case EventKind::kCrates: referee_->OnCrates(std::get<drivers::CrateStates>(ev.payload)); break;
       case EventKind::kPoseEstimate: referee_->OnSlamPose(ev.t_us, std::get<Pose2D>(ev.payload)); break;
       case EventKind::kMap: referee_->OnMap(std::get<std::shared_ptr<const mapping::OccupancyGrid>>(ev.payload)); break;
       case EventKind::kPath: path_ = std::get<drivers::Path>(ev.payload).poses; break;
@@ -123,7 +135,7 @@ class RefereeStage : public Stage {
       << sim::Title(s.event) << " - arena " << arena << ", seed " << ctx.seed << ": " << result << " after "
       << Num(s.time_s, 4) << " s (" << Num(rtf, 3) << "x real time), " << s.collisions << " collisions\n";
     for (const sim::RubricItem& i : s.items) {
-      t << "  " << std::left << std::setw(14) << i.name << std::setw(74) << i.detail << std::right << std::setw(4)
+      t << "  " << std::left << std::setw(20) << i.name << std::setw(68) << i.detail << std::right << std::setw(4)
         << i.points << " / " << i.max << "\n";
     }
     t << "  " << std::left << std::setw(88) << "total" << std::right << std::setw(4) << s.total << " / " << s.max_total
@@ -144,6 +156,9 @@ class RefereeStage : public Stage {
                                                 {driven, 31, 119, 180, false, "SLAM path"}};
       if (!path_.empty()) overlays.push_back({path_, 214, 39, 40, false, "last planned path"});
       if (!stops.empty()) overlays.push_back({stops, 44, 160, 44, true, "targets and drop-offs"});
+      std::vector<Pose2D> crates;
+      for (const sim::CrateResult& c : s.crates) crates.push_back(inv.Compose(c.final_pose));
+      if (!crates.empty()) overlays.push_back({crates, 148, 103, 189, true, "crates at the end"});
       if (s.map && !s.map->unmapped.empty())
         overlays.push_back({s.map->unmapped, 240, 140, 0, true, "reachable space not mapped"});
       drivers::WriteMapPngWithOverlays(mapping::CropToKnown(*map, 0.3), overlays, 4, dir + "/final_map.png");
@@ -167,26 +182,31 @@ class RefereeStage : public Stage {
 }  // namespace
 
 StageType RefereeStageType() {
-  return {
-      "referee",
-      "scores a competition event on the simulator (libs/sim: pose tiers, map quality, time, collisions), ends the run "
-      "when the mission finishes or time runs out, writes score.json, trajectories and the final map",
-      [](config::Section& s) -> std::unique_ptr<Stage> {
-        RefereeStageOptions o;
-        auto& r = o.referee;
-        r.event = s.GetEnum("event", r.event,
-                            {{"speed_run", sim::CompetitionEvent::kSpeedRun},
-                             {"maze_explorer", sim::CompetitionEvent::kMazeExplorer},
-                             {"warehouse", sim::CompetitionEvent::kWarehouse}},
-                            "which event is scored");
-        r.time_limit_s =
-            s.GetDouble("time_limit_s", r.time_limit_s, "the run ends here if the mission has not [s]", 1.0, 1e5);
-        r.finish_delay_s =
-            s.GetDouble("finish_delay_s", r.finish_delay_s, "simulate this long after the mission ends [s]", 0.0, 60.0);
-        o.mission_status_channel =
-            s.GetString("mission_status_channel", o.mission_status_channel, "channel of the mission's states");
-        return std::make_unique<RefereeStage>(o);
-      }};
+  return {"referee",
+          "scores a competition event on the simulator (libs/sim: pose tiers, map quality, time, collisions, crates "
+          "lifted and stacked), ends the run "
+          "when the mission finishes or time runs out, writes score.json, trajectories and the final map",
+          [](config::Section& s) -> std::unique_ptr<Stage> {
+            RefereeStageOptions o;
+            auto& r = o.referee;
+            r.event = s.GetEnum("event", r.event,
+                                {{"speed_run", sim::CompetitionEvent::kSpeedRun},
+                                 {"maze_explorer", sim::CompetitionEvent::kMazeExplorer},
+                                 {"warehouse", sim::CompetitionEvent::kWarehouse},
+                                 {"heavy_lift", sim::CompetitionEvent::kHeavyLift}},
+                                "which event is scored");
+            r.time_limit_s =
+                s.GetDouble("time_limit_s", r.time_limit_s, "the run ends here if the mission has not [s]", 1.0, 1e5);
+            r.finish_delay_s = s.GetDouble("finish_delay_s", r.finish_delay_s,
+                                           "simulate this long after the mission ends [s]", 0.0, 60.0);
+            r.crates = static_cast<int>(s.GetInt("crates", r.crates,
+                                                 "heavy_lift: judge only the world's first this many stack assignments "
+                                                 "(0: all)",
+                                                 0, 1000));
+            o.mission_status_channel =
+                s.GetString("mission_status_channel", o.mission_status_channel, "channel of the mission's states");
+            return std::make_unique<RefereeStage>(o);
+          }};
 }
 
 }  // namespace mbot::app

@@ -28,6 +28,7 @@ const char* ToString(TaskKind kind) {
     case TaskKind::kExplore: return "explore";
     case TaskKind::kWarehouse: return "warehouse";
     case TaskKind::kFollow: return "follow";
+    case TaskKind::kHeavyLift: return "heavy_lift";
   }
   return "?";
 }
@@ -55,6 +56,25 @@ void Mission::OnMap(std::shared_ptr<const mapping::OccupancyGrid> map) { map_ = 
 void Mission::OnSlamState(mapping::SlamState state) { slam_state_ = state; }
 
 void Mission::OnPath(const std::vector<Pose2D>& path) { task_->PathReceived(path); }
+
+void Mission::OnTags(int64_t t_us, const std::vector<TagSeen>& tags) {
+  Pose2D pose;
+  if (PoseAt(t_us, &pose)) task_->TagsSeen(*this, pose, tags);
+}
+
+bool Mission::PoseAt(int64_t t_us, Pose2D* pose) const {
+  if (!has_slam_ || odometry_.empty()) return false;
+  Pose2D odo_slam, odo_then;
+  if (!motion::InterpolateAt(odometry_, slam_.t_us, 200'000, &odo_slam) ||
+      !motion::InterpolateAt(odometry_, t_us, 200'000, &odo_then))
+    return false;
+  *pose = slam_.pose.Compose(odo_slam.Inverse().Compose(odo_then));
+  return true;
+}
+
+void Mission::CommandFork(double height_m) {
+  if (out_) out_->emplace_back(std::in_place_type<ForkOut>, ForkOut{height_m});
+}
 
 MissionReport Mission::Report() const {
   MissionReport r;

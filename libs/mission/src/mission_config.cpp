@@ -22,9 +22,11 @@ MissionOptions ParseMissionOptions(config::Section& s) {
                      {{"waypoints", TaskKind::kWaypoints},
                       {"explore", TaskKind::kExplore},
                       {"warehouse", TaskKind::kWarehouse},
-                      {"follow", TaskKind::kFollow}},
+                      {"follow", TaskKind::kFollow},
+                      {"heavy_lift", TaskKind::kHeavyLift}},
                      "follow a circuit of waypoints, explore the unknown and return home, make the Warehouse's "
-                     "deliveries in the known map, or drive the paths a GUI sends");
+                     "deliveries in the known map, drive the paths a GUI sends, or stack crates with the forklift "
+                     "(Heavy Lift)");
   // Every task's inputs are read whatever the task (a config that names the Warehouse's may run
   // another task); only the chosen task's are required.
   const bool describing = s.describing();
@@ -78,7 +80,71 @@ MissionOptions ParseMissionOptions(config::Section& s) {
                           "warehouse: how long to stand at a target or drop-off [s] (the rules ask " +
                               std::to_string(static_cast<int>(warehouse::kDwellS)) + " s)",
                           0.0, 600.0);
+  o.heavy_lift = ParseHeavyLiftOptions(s, o.task == TaskKind::kHeavyLift && !describing);
   return o;
+}
+
+HeavyLiftOptions ParseHeavyLiftOptions(config::Section& s, bool required) {
+  HeavyLiftOptions h;
+  const auto doc = [](const std::string& text) { return "heavy_lift: " + text; };
+  for (const std::string& item :
+       s.GetList("stack", {},
+                 doc("the day's crates, in order: <crate id>:<id of the crate to stack it on>, comma separated"))) {
+    const size_t colon = item.find(':');
+    int a = -1, b = -1;
+    try {
+      size_t used_a = 0, used_b = 0;
+      if (colon != std::string::npos) {
+        a = std::stoi(item.substr(0, colon), &used_a);
+        b = std::stoi(item.substr(colon + 1), &used_b);
+      }
+      if (colon == std::string::npos || used_a != colon || used_b != item.size() - colon - 1) a = -1;
+    } catch (const std::exception&) {
+      a = -1;
+    }
+    if (a < 0 || b < 0 || a == b) s.Fail("stack", "'" + item + "' is not <crate id>:<other crate id>");
+    h.stack.emplace_back(a, b);
+  }
+  if (required && h.stack.empty()) s.Fail("stack", "task = heavy_lift needs at least one <crate>:<crate> pair");
+  h.crate_side_m = s.GetDouble("crate_side_m", h.crate_side_m, doc("the crates' side [m]"), 0.01, 2.0);
+  h.crate_height_m = s.GetDouble("crate_height_m", h.crate_height_m, doc("the crates' height [m]"), 0.01, 2.0);
+  h.fork_tip_x_m =
+      s.GetDouble("fork_tip_x_m", h.fork_tip_x_m, doc("the tines' tips ahead of the robot's centre [m]"), 0.01, 2.0);
+  h.insert_depth_m = s.GetDouble("insert_depth_m", h.insert_depth_m,
+                                 doc("how far past a crate's face the tips go before lifting [m]"), 0.0, 1.0);
+  h.standoff_m = s.GetDouble("standoff_m", h.standoff_m,
+                             doc("the tips stop this far before a face to look and line up [m]"), 0.02, 2.0);
+  h.carry_height_m = s.GetDouble("carry_height_m", h.carry_height_m,
+                                 doc("the tines' height carrying a crate from place to place (low: it hides less of "
+                                     "the camera's view) [m]"),
+                                 0.0, 2.0);
+  h.stack_height_m = s.GetDouble("stack_height_m", h.stack_height_m,
+                                 doc("the tines' height setting a crate on another (its underside above the other's "
+                                     "top) [m]"),
+                                 0.0, 2.0);
+  h.place_standoff_m = s.GetDouble(
+      "place_standoff_m", h.place_standoff_m,
+      doc("before stacking, the carried crate's centre stops this far short of the other's [m]"), 0.02, 2.0);
+  h.retreat_m = s.GetDouble("retreat_m", h.retreat_m, doc("backing off after a lift or a stack [m]"), 0.05, 5.0);
+  h.approach_speed_m_s = s.GetDouble("approach_speed_m_s", h.approach_speed_m_s,
+                                     doc("speed inserting, placing and backing off [m/s]"), 0.005, 0.5);
+  h.align_lateral_m =
+      s.GetDouble("align_lateral_m", h.align_lateral_m,
+                  doc("at a stand-off, off the approach line by more than this: line up again [m]"), 0.001, 0.5);
+  h.align_heading_deg =
+      s.GetDouble("align_heading_deg", h.align_heading_deg,
+                  doc("at a stand-off, turned from the line by more than this: line up again [deg]"), 0.1, 45.0);
+  h.look_s = s.GetDouble("look_s", h.look_s, doc("at a stand-off, look this long before going in [s]"), 0.0, 60.0);
+  h.search_turn_rad_s = s.GetDouble("search_turn_rad_s", h.search_turn_rad_s,
+                                    doc("turn rate on the spot while looking for a crate [rad/s]"), 0.05, 3.0);
+  h.max_tag_range_m = s.GetDouble("max_tag_range_m", h.max_tag_range_m,
+                                  doc("tag sightings farther than this are left out [m]"), 0.1, 20.0);
+  h.no_path_wait_s =
+      s.GetDouble("no_path_wait_s", h.no_path_wait_s,
+                  doc("no path to a crate's stand-off (the map still too young): try again this long [s]"), 0.0, 600.0);
+  h.max_attempts = static_cast<int>(
+      s.GetInt("max_attempts", h.max_attempts, doc("tries to engage a crate before giving it up"), 1, 100));
+  return h;
 }
 
 }  // namespace mbot::mission

@@ -220,6 +220,7 @@ std::unique_ptr<Task> MakeTask(const MissionOptions& o, uint64_t seed) {
     case TaskKind::kExplore: return std::make_unique<ExploreTask>(o.exploration, o.explore_period_s);
     case TaskKind::kWarehouse: return std::make_unique<WarehouseTask>(o, seed);
     case TaskKind::kFollow: return std::make_unique<FollowTask>();
+    case TaskKind::kHeavyLift: return MakeHeavyLiftTask(o);
   }
   throw std::invalid_argument("unknown task");
 }

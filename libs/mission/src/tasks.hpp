@@ -19,6 +19,8 @@ class Task {
   virtual void Arrived(Mission& m, const std::string& how) = 0;
   // The robot stalled and backs off.
   virtual void Stalled(Mission& /*m*/) {}
+  // heavy_lift: tags seen in a camera frame, with the robot's pose (map frame) when it was taken.
+  virtual void TagsSeen(Mission& /*m*/, const motion::Pose2D& /*pose*/, const std::vector<TagSeen>& /*tags*/) {}
   // A path from outside arrived (follow).
   virtual void PathReceived(const std::vector<motion::Pose2D>& /*path*/) {}
   // After completing or failing, the task takes up work again (follow: a new path).
@@ -29,5 +31,6 @@ class Task {
 };
 
 std::unique_ptr<Task> MakeTask(const MissionOptions& options, uint64_t seed);
+std::unique_ptr<Task> MakeHeavyLiftTask(const MissionOptions& options);  // heavy_lift_task.cpp
 
 }  // namespace mbot::mission

@@ -124,7 +124,8 @@ bool Forklift::Step(double dt_s, const Pose2D& pose) {
   }
   c.pose = pose.Compose(carry_offset_);
   c.z_m = height_ - o_.slot_m;
-  c.lifted = c.lifted || c.z_m >= o_.lift_clear_m - kEps;
+  const bool lifted_now = !c.lifted && c.z_m >= o_.lift_clear_m - kEps;  // a change to report
+  c.lifted = c.lifted || lifted_now;
   double support = 0.0;  // what the crate would rest on
   const std::vector<Crate>& crates = world_->crates();
   for (size_t i = 0; i < crates.size(); ++i) {
@@ -134,7 +135,7 @@ bool Forklift::Step(double dt_s, const Pose2D& pose) {
   }
   if (c.z_m >= support - kEps) {
     world_->SetCrate(engaged_, c);
-    return false;
+    return lifted_now;
   }
   SetDown(&c, pose);
   return true;

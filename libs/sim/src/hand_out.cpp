@@ -36,6 +36,15 @@ std::vector<std::string> HandOut(const World& world, const std::string& world_pa
     sets.push_back("mission.targets=" + Poses(in.targets));
     sets.push_back("mission.dropoffs=" + Poses(in.dropoffs));
   }
+  if (setup.task == "heavy_lift") {
+    if (in.stacks.empty()) {
+      throw std::invalid_argument(world_path + " has no 'stack' lines: no Heavy Lift to hand out");
+    }
+    std::string pairs;
+    for (const auto& [a, b] : in.stacks)
+      pairs += (pairs.empty() ? "" : ", ") + std::to_string(a) + ":" + std::to_string(b);
+    sets.push_back("mission.stack=" + pairs);
+  }
   if (setup.localization) {
     const std::filesystem::path dir = std::filesystem::path(map_path).parent_path();
     if (!dir.empty()) std::filesystem::create_directories(dir);

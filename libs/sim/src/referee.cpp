@@ -33,6 +33,7 @@ const char* ToString(CompetitionEvent event) {
     case CompetitionEvent::kSpeedRun: return "speed_run";
     case CompetitionEvent::kMazeExplorer: return "maze_explorer";
     case CompetitionEvent::kWarehouse: return "warehouse";
+    case CompetitionEvent::kHeavyLift: return "heavy_lift";
   }
   return "?";
 }
@@ -42,6 +43,7 @@ const char* Title(CompetitionEvent event) {
     case CompetitionEvent::kSpeedRun: return "Speed Run";
     case CompetitionEvent::kMazeExplorer: return "Maze Explorer";
     case CompetitionEvent::kWarehouse: return "Warehouse";
+    case CompetitionEvent::kHeavyLift: return "Heavy Lift";
   }
   return "?";
 }
@@ -113,6 +115,10 @@ MapQuality Quality(const World& world, const mapping::OccupancyGrid& m, const Po
 Referee::Referee(const RefereeOptions& options, World world, uint64_t seed) : o_(options), world_(std::move(world)) {
   if (o_.event == CompetitionEvent::kWarehouse) {
     stops_ = warehouse::Stops(world_.PosesLabelled("target"), world_.PosesLabelled("dropoff"), seed);
+  }
+  if (o_.event == CompetitionEvent::kHeavyLift && world_.stacks().empty()) {
+    throw std::invalid_argument("referee: Heavy Lift in '" + world_.name() +
+                                "', which names no 'stack <crate> <on crate>' assignments");
   }
 }
 
@@ -199,7 +205,32 @@ Score Referee::Judge() const {
       s.slam_final_error = ErrorBetween(s.map_frame.Compose(slam_.back().pose), truth_then);
     }
   }
-  if (!warehouse) {
+  if (o_.event == CompetitionEvent::kHeavyLift) {
+    std::vector<std::pair<int, int>> stacks = world_.stacks();
+    if (o_.crates > 0 && static_cast<size_t>(o_.crates) < stacks.size()) stacks.resize(o_.crates);
+    for (const auto& [id, on] : stacks) {
+      CrateResult r{id, on, false, false, false, {}, 0.0};
+      bool seen = false;
+      for (const drivers::CrateState& c : crates_.crates) {
+        if (c.id != id) continue;
+        seen = true;
+        r.lifted = c.lifted, r.fell = c.fell, r.final_pose = c.pose, r.final_z_m = c.z_m;
+        r.stacked = !c.carried && c.on_id == on;
+      }
+      s.crates.push_back(r);
+      const std::string name = "crate " + std::to_string(id);
+      s.items.push_back({"lift " + name,
+                         !seen      ? "not in the simulator's crates"
+                         : r.lifted ? "lifted clear of the floor"
+                                    : "never lifted",
+                         r.lifted ? 50 : 0, 50});
+      s.items.push_back({"stack " + name + " on " + std::to_string(on),
+                         r.stacked ? "standing on crate " + std::to_string(on)
+                         : r.fell  ? "set down off-centre: it fell"
+                                   : "not on crate " + std::to_string(on) + " at the end",
+                         r.stacked ? 50 : 0, 50});
+    }
+  } else if (!warehouse) {
     // Final pose against the start (the robot had to come back).
     const PoseError e = ErrorBetween(s.final_pose, s.start);
     s.final_error = e;

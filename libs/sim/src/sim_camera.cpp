@@ -154,7 +154,8 @@ inline void SimCamera::CrateHit(const Scene& sc, size_t k, const Ray& r, float* 
       if (std::abs(b.p[a]) > half[a]) return;
       continue;
     }
-    double ta = (-half[a] - b.p[a]) / u[a], tb = (half[a] - b.p[a]) / u[a];
+    const double inv = 1.0 / u[a];
+    double ta = (-half[a] - b.p[a]) * inv, tb = (half[a] - b.p[a]) * inv;
     if (ta > tb) std::swap(ta, tb);
     if (ta > t0) t0 = ta, axis = a;
     t1 = std::min(t1, tb);
@@ -276,27 +277,35 @@ cv::Mat SimCamera::RenderFloat(const World& world, const motion::Pose2D& robot) 
       }
     }
   }
-  // Area sampling where a crate is: its tag, and its outline (a pixel whose neighbour sees another
-  // surface).
+  // Area sampling where a crate's pixels change: its outline (a neighbour sees another surface) and
+  // its tag's cell edges (a neighbour on the same face differs in brightness). Flat areas keep their
+  // one ray: area sampling would give the same value.
   cv::Mat out = image.clone();
+  const int w = o_.width, h = o_.height;
   for (int v = any_crate.y; v < any_crate.br().y; ++v) {
+    const int* id = surface.ptr<int>(v);
+    const int* up = surface.ptr<int>(std::max(v - 1, 0));
+    const int* down = surface.ptr<int>(std::min(v + 1, h - 1));
+    const float* val = image.ptr<float>(v);
+    const float* val_up = image.ptr<float>(std::max(v - 1, 0));
+    const float* val_down = image.ptr<float>(std::min(v + 1, h - 1));
+    const uint8_t* tag = on_tag.ptr<uint8_t>(v);
+    float* o = out.ptr<float>(v);
     for (int u = any_crate.x; u < any_crate.br().x; ++u) {
-      const int id = surface.at<int>(v, u);
-      bool edge = false;
-      for (const auto& [du, dv] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
-        const int uu = u + du, vv = v + dv;
-        if (uu >= 0 && uu < o_.width && vv >= 0 && vv < o_.height && surface.at<int>(vv, uu) != id) edge = true;
-      }
-      if (!edge && !on_tag.at<uint8_t>(v, u)) continue;
+      const int l = std::max(u - 1, 0), r = std::min(u + 1, w - 1);
+      const bool outline = id[l] != id[u] || id[r] != id[u] || up[u] != id[u] || down[u] != id[u];
+      const bool cell_edge =
+          tag[u] && (val[l] != val[u] || val[r] != val[u] || val_up[u] != val[u] || val_down[u] != val[u]);
+      if (!outline && !cell_edge) continue;
       float sum = 0;
-      Hit h;
+      Hit hit;
       for (const double j : {-0.25, 0.25}) {
         for (const double i : {-0.25, 0.25}) {
-          Shade(sc, RayAt(u + i, v + j), &h);
-          sum += h.value;
+          Shade(sc, RayAt(u + i, v + j), &hit);
+          sum += hit.value;
         }
       }
-      out.at<float>(v, u) = 0.25f * sum;
+      o[u] = 0.25f * sum;
     }
   }
   return out;

@@ -287,6 +287,7 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
   std::vector<ArenaPose> poses;
   std::vector<std::pair<Crate, int>> crates;  // with their lines, added once the walls exist
   std::optional<CrateArea> crate_area;
+  std::vector<std::pair<int, int>> stacks;
   std::string name;
   double thickness = 0.02, resolution = 0.025;
   int name_line = 0, resolution_line = 0, first_wall_line = 0;
@@ -403,9 +404,16 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
         a.first_id = static_cast<int>(first);
       }
       crate_area = a;
+    } else if (stmt == "stack") {
+      if (args.size() != 2)
+        fail("'stack' needs <crate id> <id of the crate it goes on>, got " + std::to_string(args.size()));
+      const double a = number(stmt, args[0]), b = number(stmt, args[1]);
+      if (a < 0 || b < 0 || a > 586 || b > 586 || a != std::floor(a) || b != std::floor(b) || a == b)
+        fail("'stack' needs two different tag36h11 ids (0-586), got " + args[0] + " " + args[1]);
+      stacks.emplace_back(static_cast<int>(a), static_cast<int>(b));
     } else {
       fail("unknown statement '" + stmt +
-           "' (known: name, resolution, thickness, wall, box, pose, crate, crates_at_random)");
+           "' (known: name, resolution, thickness, wall, box, pose, crate, crates_at_random, stack)");
     }
   }
   if (walls.empty()) throw std::runtime_error(origin + ": no walls (an arena needs at least one 'wall' or 'box')");
@@ -418,6 +426,7 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
   w.name_ = name.empty() ? fs::path(origin).stem().string() : name;
   w.poses_ = std::move(poses);
   w.crate_area_ = crate_area;
+  w.stacks_ = std::move(stacks);
   for (const auto& [crate, at] : crates) {
     try {
       w.AddCrate(crate);
@@ -793,6 +802,7 @@ EventInputs EventInputsOf(const World& world) {
   }
   in.targets = world.PosesLabelled("target");
   in.dropoffs = world.PosesLabelled("dropoff");
+  in.stacks = world.stacks();
   return in;
 }
 
@@ -830,6 +840,12 @@ void PlaceCratesAtRandom(World* world, const CrateArea& area, uint64_t seed, con
         std::abs(c.pose.y - area.y) + reach > 0.5 * area.side_m)
       continue;
     if (c.DistanceTo(keep_clear.x, keep_clear.y) < keep_clear_m) continue;
+    // Room between crates for the robot to come up to each (its forklift needs a clear face).
+    bool crowded = false;
+    for (const Crate& other : world->crates()) {
+      for (const auto& [x, y] : other.Outline(0.01)) crowded = crowded || c.DistanceTo(x, y) < area.min_gap_m;
+    }
+    if (crowded) continue;
     try {
       world->AddCrate(c);
     } catch (const std::invalid_argument&) {

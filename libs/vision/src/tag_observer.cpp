@@ -21,6 +21,16 @@ cv::Matx33d CameraMount::Rotation() const {
   return Rz * Ry * Rx * ahead;
 }
 
+TagOnRobot TagInRobotFrame(const CameraMount& mount, const cv::Vec3d& t_camera, const std::array<double, 4>& q) {
+  const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  const double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
+  // The tag's z axis (into the printed face) in the camera frame: the rotation's third column.
+  const cv::Vec3d into(2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y));
+  const cv::Matx33d R = mount.Rotation();
+  const cv::Vec3d d = R * into;
+  return {R * t_camera + mount.Translation(), std::atan2(-d[1], -d[0])};
+}
+
 std::array<double, 4> QuaternionOf(const cv::Matx33d& R) {
   // Shepperd's method: the largest of the four squares decides, so no division is near zero.
   const double t = R(0, 0) + R(1, 1) + R(2, 2);

@@ -26,8 +26,49 @@
 
 namespace mbot::mission {
 
-enum class TaskKind { kWaypoints, kExplore, kWarehouse, kFollow };
+enum class TaskKind { kWaypoints, kExplore, kWarehouse, kFollow, kHeavyLift };
 const char* ToString(TaskKind kind);
+
+// A tag the camera saw, in the robot frame at the frame's time: the tag's centre [m] and the
+// heading its face looks towards (the face's outward normal, robot frame) [rad].
+struct TagSeen {
+  int id = 0;
+  double x_m = 0, y_m = 0, z_m = 0;
+  double facing_rad = 0;
+};
+
+// What the forklift reports (MBOT_FORKLIFT_STATUS): the tines' height and target [m], the crate on
+// them (-1: none), and whether it is lifted off what it stood on.
+struct ForkliftState {
+  double height_m = 0, target_m = 0;
+  int crate_id = -1;
+  bool carrying = false;
+};
+
+// Heavy Lift: which crate goes on which, and the forklift's and crates' geometry the moves are
+// worked out from (the botlab's: config/heavy_lift.ini documents them).
+struct HeavyLiftOptions {
+  std::vector<std::pair<int, int>> stack;  // (crate to lift, crate to set it on), in order
+  double crate_side_m = 0.10;              // crates are square in plan
+  double crate_height_m = 0.08;
+  double fork_tip_x_m = 0.18;    // the tines' tips ahead of the robot's centre
+  double insert_depth_m = 0.04;  // how far past a crate's face the tips go before lifting
+  double standoff_m = 0.12;      // the tips stop this far before a face to look and align
+  // The tines' height carrying a crate: low while travelling (the crate hides less of the camera's
+  // view), high to set it on another (its underside above the other's top).
+  double carry_height_m = 0.05;
+  double stack_height_m = 0.13;
+  double place_standoff_m = 0.15;    // before stacking, the carried crate stops this far short
+  double retreat_m = 0.25;           // backing off after a lift or a stack
+  double approach_speed_m_s = 0.05;  // inserting, placing and backing off
+  double align_lateral_m = 0.015;    // at the stand-off: off the approach line by at most this …
+  double align_heading_deg = 5.0;    // … and turned from it by at most this, else drive to it again
+  double look_s = 1.0;               // at a stand-off, look this long (fresh sightings refine the crate)
+  double search_turn_rad_s = 0.6;    // turning on the spot to find a crate not yet seen (and once at the start)
+  double max_tag_range_m = 1.6;      // farther sightings are left out (their pose is too rough)
+  int max_attempts = 3;              // tries to engage a crate before giving it up
+  double no_path_wait_s = 10.0;      // no path to a crate (the map still too young): try again this long
+};
 
 struct MissionOptions {
   TaskKind task = TaskKind::kWaypoints;
@@ -53,6 +94,7 @@ struct MissionOptions {
   double backoff_s = 0.6;   // reversing at 0.1 m/s
   int max_stalls = 10;      // stalls on the way to one goal before the mission gives up
   double dwell_s = 2.5;     // warehouse: standing at a stop (lifting, setting down) [s]
+  HeavyLiftOptions heavy_lift;
 };
 
 // What the mission asks the caller to do, in order: publish a state, publish a path (the
@@ -60,7 +102,11 @@ struct MissionOptions {
 struct PathOut {
   std::vector<motion::Pose2D> poses;
 };
-using MissionOutput = std::variant<MissionStatus, PathOut, motion::VelocityCommand>;
+// Heavy Lift: the height the forklift's tines should go to (MBOT_FORKLIFT_CMD).
+struct ForkOut {
+  double height_m = 0;
+};
+using MissionOutput = std::variant<MissionStatus, PathOut, motion::VelocityCommand, ForkOut>;
 
 // Counters for the mission's report.
 struct MissionReport {
@@ -74,6 +120,10 @@ struct MissionReport {
   std::vector<planning::FrontierLeft> frontiers_left;
   // warehouse: stops in all, and done by the mission's own estimate.
   int stops = 0, stops_done = 0;
+  // heavy_lift: crates to stack, lifted and set down (on their crates, it meant) by the forklift's
+  // report; tag sightings used.
+  int crates = 0, crates_lifted = 0, crates_set_down = 0;
+  long long tag_sightings = 0;
 };
 
 class Task;
@@ -93,6 +143,9 @@ class Mission {
   void OnSlamState(mapping::SlamState state);
   // follow: a path sent by a GUI (replaces the one being driven).
   void OnPath(const std::vector<motion::Pose2D>& path);
+  // heavy_lift: the tags in a camera frame taken at t_us (robot frame), and the forklift's report.
+  void OnTags(int64_t t_us, const std::vector<TagSeen>& tags);
+  void OnForklift(const ForkliftState& state) { forklift_ = state; }
   // The control step, on every odometry message (the firmware's 50 Hz): what to publish and
   // command now. Every step ends with exactly one velocity command.
   std::vector<MissionOutput> OnOdometry(int64_t t_us, const motion::Pose2D& odometry);
@@ -108,7 +161,12 @@ class Mission {
   void SetPath(const std::vector<motion::Pose2D>& path, bool publish = true);
   // The path ends at `goal`, where the robot must stop within the final tolerances.
   void SetGoal(const motion::Pose2D& goal);
-  void Hold();  // command zero velocity this step
+  void Hold();                                                        // command zero velocity this step
+  void Drive(double v_m_s, double w_rad_s) { Send(v_m_s, w_rad_s); }  // this step's command, from the task
+  void CommandFork(double height_m);                                  // heavy_lift: the tines' target height
+  const std::optional<ForkliftState>& forklift() const { return forklift_; }
+  // The pose at t_us (map frame): the SLAM pose moved by odometry; false outside the odometry kept.
+  bool PoseAt(int64_t t_us, motion::Pose2D* pose) const;
   bool final_leg() const { return final_leg_; }
   void EndFinalLeg() { final_leg_ = false; }
   bool backing_off() const { return t_us_ < backoff_until_us_; }
@@ -136,6 +194,7 @@ class Mission {
   motion::OdometryContinuity continuity_;
   std::shared_ptr<const mapping::OccupancyGrid> map_;
   std::optional<mapping::SlamState> slam_state_;
+  std::optional<ForkliftState> forklift_;
   bool final_leg_ = false;  // the path ends at goal_, where the robot must stop within the tolerances
   uint64_t seed_ = 0;
   int rounds_ = 0;  // completed rounds started again (repeat)

@@ -32,8 +32,10 @@ namespace mbot::sim {
 
 struct ForkliftOptions {
   bool enabled = false;  // a robot without a forklift has no tines: crates are only obstacles
-  double tip_x_m = 0.15;
-  double tine_length_m = 0.06;
+  // The tips 18 cm ahead of the centre and 8 cm long: the tines reach past the MBot's 10 cm-radius
+  // body, so a crate fully on them still clears the body by 2 cm at the crate's sides' corners.
+  double tip_x_m = 0.18;
+  double tine_length_m = 0.08;
   double min_height_m = 0.0;
   double max_height_m = 0.15;
   double speed_m_s = 0.05;  // how fast the tines move up or down

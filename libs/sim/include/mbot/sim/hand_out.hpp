@@ -19,7 +19,8 @@ struct EventSetup {
 };
 
 // The settings for `setup` in `world`: mission.waypoints (the `waypoint` poses in the `start`
-// frame) for task = waypoints, mission.targets and mission.dropoffs for task = warehouse, and for
+// frame) for task = waypoints, mission.targets and mission.dropoffs for task = warehouse,
+// mission.stack (the `stack` lines, <crate>:<crate>, …) for task = heavy_lift, and for
 // localization slam.map_file = `map_path`, where the known map (RenderKnownMap) is written.
 // Throws std::invalid_argument naming `world_path` when the world lacks what the task needs.
 std::vector<std::string> HandOut(const World& world, const std::string& world_path, const EventSetup& setup,

@@ -1,10 +1,12 @@
 // The competition's judge (Winter 2024 rules): it watches an event on the simulator — the true pose,
 // collisions and the world, which only the simulator knows, beside what the stack produced (its SLAM
 // poses and map, its states) — and scores it into a Score: the rubric's lines and points, the final
-// pose errors, the map's quality, the Warehouse's stops and levels. Events: speed_run and
-// maze_explorer (SLAM from the start pose: the map frame is the start frame), warehouse
+// pose errors, the map's quality, the Warehouse's stops and levels, Heavy Lift's crates. Events:
+// speed_run and maze_explorer (SLAM from the start pose: the map frame is the start frame), warehouse
 // (localization in the given map: the map frame is the world frame; deliveries judged from the true
-// pose against mission/warehouse_rules.hpp). Times are microseconds on the simulation's clock.
+// pose against mission/warehouse_rules.hpp), heavy_lift (SLAM from the start pose; +50 per crate
+// lifted clear of the floor, +50 per crate standing on its designated crate at the end, judged from
+// the simulator's crates). Times are microseconds on the simulation's clock.
 #pragma once
 
 #include <cstdint>
@@ -13,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "mbot/drivers/events.hpp"
 #include "mbot/mapping/occupancy_grid.hpp"
 #include "mbot/mapping/slam.hpp"
 #include "mbot/mission/mission_state.hpp"
@@ -22,14 +25,15 @@
 
 namespace mbot::sim {
 
-enum class CompetitionEvent { kSpeedRun, kMazeExplorer, kWarehouse };
-const char* ToString(CompetitionEvent event);  // "speed_run", "maze_explorer", "warehouse"
+enum class CompetitionEvent { kSpeedRun, kMazeExplorer, kWarehouse, kHeavyLift };
+const char* ToString(CompetitionEvent event);  // "speed_run", "maze_explorer", "warehouse", "heavy_lift"
 const char* Title(CompetitionEvent event);     // "Speed Run" …
 
 struct RefereeOptions {
   CompetitionEvent event = CompetitionEvent::kSpeedRun;
   double time_limit_s = 180.0;  // the run ends here if the mission has not
   double finish_delay_s = 0.5;  // keep simulating this long after the mission ends (the robot stops)
+  int crates = 0;               // Heavy Lift: judge only the world's first this many stack assignments (0: all)
 };
 
 // One line of the rubric: what was judged, how it went, the points.
@@ -56,6 +60,17 @@ struct StopResult {
   bool missed = false;              // the robot stood at a later stop first
 };
 
+// Heavy Lift: one of the day's assignments (crate `id` onto crate `on_id`) and how it ended, from
+// the simulator's crates (SIM_CRATES).
+struct CrateResult {
+  int id = 0, on_id = 0;
+  bool lifted = false;   // lifted clear of the floor at some point
+  bool stacked = false;  // ends standing on its designated crate
+  bool fell = false;     // was set down off-centre and fell
+  motion::Pose2D final_pose;
+  double final_z_m = 0;
+};
+
 struct Score {
   CompetitionEvent event = CompetitionEvent::kSpeedRun;
   mission::MissionState state = mission::MissionState::kInitializing;
@@ -75,6 +90,7 @@ struct Score {
   std::optional<double> localized_at_s;       // the Warehouse: when global localization settled
   int levels_reached = 0;
   std::vector<StopResult> stops;
+  std::vector<CrateResult> crates;  // Heavy Lift
   std::vector<RubricItem> items;
   int total = 0, max_total = 0;
 };
@@ -90,7 +106,7 @@ MapQuality Quality(const World& world, const mapping::OccupancyGrid& map, const 
 
 class Referee {
  public:
-  // Throws std::invalid_argument for a Warehouse in a world without its targets and drop-offs.
+  // Throws std::invalid_argument for a Heavy Lift in a world without stack assignments.
   Referee(const RefereeOptions& options, World world, uint64_t seed);
 
   // Called first for every event of the stream, with its time.
@@ -101,6 +117,8 @@ class Referee {
   void OnMap(std::shared_ptr<const mapping::OccupancyGrid> map) { map_ = std::move(map); }
   void OnSlamState(int64_t t_us, mapping::SlamState state);
   void OnMissionStatus(int64_t t_us, const mission::MissionStatus& status);
+  // Heavy Lift: the simulator's crates as they are now.
+  void OnCrates(const drivers::CrateStates& crates) { crates_ = crates; }
   // Why the run should end now — the mission ended finish_delay_s ago, or the time limit — once;
   // nullopt otherwise.
   std::optional<std::string> StopReason(int64_t t_us);
@@ -131,6 +149,8 @@ class Referee {
   int near_stop_ = -1;                 // the stop the robot stands at, since near_since_us_
   bool left_last_stop_ = true;         // the robot has moved off the last stop done
   int64_t near_since_us_ = -1;
+  // Heavy Lift.
+  drivers::CrateStates crates_;
 };
 
 }  // namespace mbot::sim

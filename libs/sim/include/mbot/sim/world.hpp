@@ -37,7 +37,10 @@ struct WallSegment {
 //   crates_at_random <count> <x> <y> [<side> <first_id>]
 //                                    `count` crates (ids first_id, first_id + 1, …; default 1) of the
 //                                    default size at random poses inside the side × side square
-//                                    (default 1 m) centred at (x, y), drawn from the run's seed
+//                                    (default 1 m) centred at (x, y), drawn from the run's seed,
+//                                    each at least 0.3 m from any other crate
+//   stack <id> <on_id>               Heavy Lift: crate `id` is to be stacked on crate `on_id`, in
+//                                    the order of the lines (the day's assignments)
 // Errors name the file and the line. Walls are capsules: the segment thickened by thickness/2 on
 // every side, ends rounded (so walls meeting at a corner leave no notch); Raycast, Collides and
 // ClearanceAt all use that one shape. One thickness per arena: a `thickness` statement after the
@@ -53,6 +56,7 @@ struct CrateArea {
   double x = 0.0, y = 0.0;  // the square's centre
   double side_m = 1.0;
   int first_id = 1;
+  double min_gap_m = 0.3;  // between a crate's footprint and any other's
 };
 
 // A crate: a box on the floor that the lidar sees and the robot's body must not touch. Not part of
@@ -138,6 +142,8 @@ class World {
   void AddCrate(const Crate& crate);
   // The arena's crates_at_random request, if any (PlaceCratesAtRandom resolves it).
   const std::optional<CrateArea>& crate_area() const { return crate_area_; }
+  // Heavy Lift's assignments (stack statements): (crate, crate it goes on), in order.
+  const std::vector<std::pair<int, int>>& stacks() const { return stacks_; }
   double wall_thickness() const { return thickness_; }  // 0 for a grid world
   bool is_grid_world() const { return walls_.empty(); }
 
@@ -148,6 +154,7 @@ class World {
   std::vector<ArenaPose> poses_;
   std::vector<Crate> crates_;
   std::optional<CrateArea> crate_area_;
+  std::vector<std::pair<int, int>> stacks_;
   bool WallsCollide(double x, double y, double radius_m) const;
   mapping::OccupancyGrid truth_;
   // Acceleration structures (bucket grid over the walls, or the grid's distance transform), built
@@ -175,6 +182,7 @@ struct EventInputs {
   std::vector<motion::Pose2D> waypoints;
   std::vector<motion::Pose2D> targets;
   std::vector<motion::Pose2D> dropoffs;
+  std::vector<std::pair<int, int>> stacks;  // Heavy Lift: (crate, crate it goes on)
 };
 EventInputs EventInputsOf(const World& world);
 
@@ -184,7 +192,7 @@ EventInputs EventInputsOf(const World& world);
 motion::Pose2D RandomFreePose(const World& world, double clearance_m, uint64_t seed);
 
 // Adds area.count crates of the default size at uniform random positions and headings inside the
-// area's square, each clear of the walls, of the other crates and by `keep_clear_m` of `keep_clear`
+// area's square, each clear of the walls, area.min_gap_m from the other crates and `keep_clear_m` from `keep_clear`
 // (the robot's start, so the robot does not start touching one). The same seed gives the same
 // crates. Throws std::runtime_error naming the world when 10,000 draws cannot place them all.
 void PlaceCratesAtRandom(World* world, const CrateArea& area, uint64_t seed, const motion::Pose2D& keep_clear,

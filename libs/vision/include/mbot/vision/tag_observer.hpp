@@ -64,6 +64,15 @@ class TagObserver {
 // The unit quaternion (w, x, y, z, w ≥ 0) of a rotation matrix.
 std::array<double, 4> QuaternionOf(const cv::Matx33d& R);
 
+// A tag seen by a camera at `mount`, in the robot frame: its centre, and the heading (about the
+// robot's z) its printed face looks towards — the face's outward normal. From the tag's pose in the
+// camera frame (OpenCV's): its position and the unit quaternion (w, x, y, z) of its rotation.
+struct TagOnRobot {
+  cv::Vec3d position;
+  double facing_rad = 0.0;
+};
+TagOnRobot TagInRobotFrame(const CameraMount& mount, const cv::Vec3d& t_camera, const std::array<double, 4>& q_wxyz);
+
 // Intrinsics from a camera.yaml (ReadCameraYaml).
 CameraIntrinsics IntrinsicsFromYaml(const std::string& path);
 
