@@ -73,6 +73,41 @@ TEST(LcmMessages, TagSightingsTravelAsTheBotlabsAprilTagArray) {
   EXPECT_NE(error.find("tag 12"), std::string::npos) << error;
 }
 
+// mbot_nav's own types: the forklift's command and status, and camera frames.
+TEST(LcmMessages, ForkliftAndCameraFramesRoundTrip) {
+  const Event cmd = RoundTrip(Event{0, 7, "MBOT_FORKLIFT_CMD", EventKind::kForkliftCommand, ForkliftCommand{0.125}});
+  ASSERT_EQ(cmd.kind, EventKind::kForkliftCommand);
+  EXPECT_FLOAT_EQ(std::get<ForkliftCommand>(cmd.payload).height_m, 0.125f);
+  const Event st =
+      RoundTrip(Event{0, 8, "MBOT_FORKLIFT_STATUS", EventKind::kForkliftStatus, ForkliftStatus{0.05, 0.13, 12, true}});
+  ASSERT_EQ(st.kind, EventKind::kForkliftStatus);
+  const auto& f = std::get<ForkliftStatus>(st.payload);
+  EXPECT_FLOAT_EQ(f.height_m, 0.05f);
+  EXPECT_FLOAT_EQ(f.target_m, 0.13f);
+  EXPECT_EQ(f.crate_id, 12);
+  EXPECT_TRUE(f.carrying);
+
+  CameraFrame frame;
+  frame.width = 4, frame.height = 3;
+  frame.pixels =
+      std::make_shared<const std::vector<uint8_t>>(std::vector<uint8_t>{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 255});
+  const Event img = RoundTrip(Event{0, 9, "CAMERA", EventKind::kCameraFrame, frame});
+  ASSERT_EQ(img.kind, EventKind::kCameraFrame);
+  const auto& g = std::get<CameraFrame>(img.payload);
+  EXPECT_EQ(g.width, 4);
+  EXPECT_EQ(g.height, 3);
+  ASSERT_TRUE(g.pixels);
+  EXPECT_EQ(*g.pixels, *frame.pixels);
+  // A size that disagrees with the bytes is rejected, naming the sizes.
+  std::vector<uint8_t> bytes;
+  ASSERT_TRUE(lcm_adapter::Encode(Event{0, 9, "CAMERA", EventKind::kCameraFrame, frame}, &bytes));
+  bytes[19] = 5;  // width (big-endian int32 after the hash and utime, at offset 16) 4 → 5
+  Event ev;
+  std::string error;
+  EXPECT_FALSE(lcm_adapter::Decode("CAMERA", bytes.data(), bytes.size(), ChannelRoles{}, &ev, &error));
+  EXPECT_NE(error.find("5 x 3 image with 12 bytes"), std::string::npos) << error;
+}
+
 TEST(LcmMessages, VelocityCommandRoundTrips) {
   const Event out =
       RoundTrip(Event{0, 123, "MBOT_VEL_CMD", EventKind::kMotorCommand, MotorCommand::Velocity(0.25, -1.5)});

@@ -20,6 +20,9 @@
 #include "mbot_lcm_msgs/slam_status_t.hpp"
 #include "mbot_lcm_msgs/twist2D_t.hpp"
 #include "mbot_legacy/exploration_status_t.hpp"
+#include "mbot_nav_msgs/mbot_forklift_cmd_t.hpp"
+#include "mbot_nav_msgs/mbot_forklift_status_t.hpp"
+#include "mbot_nav_msgs/mbot_image_t.hpp"
 #include "mbot_legacy/lidar_t.hpp"
 #include "mbot_legacy/mbot_encoder_t.hpp"
 #include "mbot_legacy/mbot_imu_t.hpp"
@@ -471,6 +474,55 @@ std::map<int64_t, Entry> BuildTable() {
         ev->payload = std::move(out);
         return true;
       });
+  // mbot_nav's own types (lcmtypes/mbot_nav): the forklift and camera frames.
+  const std::string kOwn = "mbot_nav";
+  add(mbot_nav_msgs::mbot_forklift_cmd_t::getHash(), "mbot_forklift_cmd_t", kOwn,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        mbot_nav_msgs::mbot_forklift_cmd_t m{};
+        if (!DecodeExact(d, n, &m, err)) return false;
+        if (!std::isfinite(m.height)) {
+          *err = "a height that is not a finite number";
+          return false;
+        }
+        ev->kind = EventKind::kForkliftCommand;
+        ev->stamp_us = m.utime;
+        ev->payload = ForkliftCommand{m.height};
+        return true;
+      });
+  add(mbot_nav_msgs::mbot_forklift_status_t::getHash(), "mbot_forklift_status_t", kOwn,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        mbot_nav_msgs::mbot_forklift_status_t m{};
+        if (!DecodeExact(d, n, &m, err)) return false;
+        if (!std::isfinite(m.height) || !std::isfinite(m.target) || m.crate_id < -1) {
+          *err = "a height or target that is not finite, or a crate id below -1";
+          return false;
+        }
+        ev->kind = EventKind::kForkliftStatus;
+        ev->stamp_us = m.utime;
+        ev->payload = ForkliftStatus{m.height, m.target, m.crate_id, m.carrying != 0};
+        return true;
+      });
+  add(mbot_nav_msgs::mbot_image_t::getHash(), "mbot_image_t", kOwn,
+      [](const std::string&, const uint8_t* d, size_t n, const ChannelRoles&, Event* ev, std::string* err) {
+        // num_bytes follows utime, width and height.
+        if (!CheckCount(d, n, 24, 1, "num_bytes", err)) return false;
+        mbot_nav_msgs::mbot_image_t m{};
+        if (!DecodeExact(d, n, &m, err)) return false;
+        if (m.width < 1 || m.height < 1 || m.width > 8192 || m.height > 8192 ||
+            static_cast<int64_t>(m.width) * m.height != m.num_bytes) {
+          *err = "a " + std::to_string(m.width) + " x " + std::to_string(m.height) + " image with " +
+                 std::to_string(m.num_bytes) + " bytes";
+          return false;
+        }
+        CameraFrame f;
+        f.width = m.width, f.height = m.height;
+        f.pixels = std::make_shared<const std::vector<uint8_t>>(m.data.begin(), m.data.end());
+        f.name = "mbot_image_t";
+        ev->kind = EventKind::kCameraFrame;
+        ev->stamp_us = m.utime;
+        ev->payload = std::move(f);
+        return true;
+      });
   return t;
 }
 
@@ -641,6 +693,34 @@ bool Encode(const Event& ev, std::vector<uint8_t>* out) {
         m.detections.push_back(t);
       }
       m.array_size = static_cast<int32_t>(m.detections.size());
+      EncodeMessage(m, out);
+      return true;
+    }
+    case EventKind::kForkliftCommand: {
+      mbot_nav_msgs::mbot_forklift_cmd_t m{};
+      m.utime = ev.stamp_us;
+      m.height = static_cast<float>(std::get<ForkliftCommand>(ev.payload).height_m);
+      EncodeMessage(m, out);
+      return true;
+    }
+    case EventKind::kForkliftStatus: {
+      const auto& f = std::get<ForkliftStatus>(ev.payload);
+      mbot_nav_msgs::mbot_forklift_status_t m{};
+      m.utime = ev.stamp_us;
+      m.height = static_cast<float>(f.height_m), m.target = static_cast<float>(f.target_m);
+      m.crate_id = f.crate_id;
+      m.carrying = f.carrying;
+      EncodeMessage(m, out);
+      return true;
+    }
+    case EventKind::kCameraFrame: {
+      const auto& f = std::get<CameraFrame>(ev.payload);
+      if (!f.pixels || f.pixels->size() != static_cast<size_t>(f.width) * f.height) return false;
+      mbot_nav_msgs::mbot_image_t m{};
+      m.utime = ev.stamp_us;
+      m.width = f.width, m.height = f.height;
+      m.num_bytes = static_cast<int32_t>(f.pixels->size());
+      m.data.assign(f.pixels->begin(), f.pixels->end());
       EncodeMessage(m, out);
       return true;
     }
