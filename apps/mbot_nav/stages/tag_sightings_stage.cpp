@@ -4,6 +4,8 @@
 // frame) and comes out as a kTagSightings event on `channel` (MBOT_APRILTAG_ARRAY), which an
 // lcm_bridge or recorder stage after it publishes as the botlab's mbot_apriltag_array_t. Writes
 // sightings.csv (every tag of every frame) and sightings.json (counts, time per frame) at the end.
+// With a forklift on the stream (MBOT_FORKLIFT_STATUS), the frame before each lift and each set-down
+// is kept with its detections drawn: forklift_<n>_<lift|set_down>_crate<id>.png.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -12,6 +14,8 @@
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
+#include "mbot/vision/apriltag_detector.hpp"
+#include "mbot/vision/images.hpp"
 #include "mbot/vision/tag_observer.hpp"
 #include "mbot/vision/vision_config.hpp"
 #include "report.hpp"
@@ -33,10 +37,13 @@ class TagSightingsStage : public Stage {
 
   void Start(const RunContext& ctx) override {
     bus_ = ctx.bus;
+    output_dir_ = ctx.output_dir;
     csv_ << "t_s,frame,id,x_m,y_m,z_m,robot_x_m,robot_y_m,bearing_deg,reprojection_px,margin\n";
   }
 
   void OnEvent(const drivers::Event& ev) override {
+    if (ev.kind == drivers::EventKind::kForkliftStatus)
+      return ForkliftChanged(std::get<drivers::ForkliftStatus>(ev.payload));
     if (ev.kind != drivers::EventKind::kCameraFrame) return;
     const auto& frame = std::get<drivers::CameraFrame>(ev.payload);
     if (!frame.pixels || frame.pixels->size() != static_cast<size_t>(frame.width) * frame.height) return;
@@ -44,6 +51,10 @@ class TagSightingsStage : public Stage {
     const auto t0 = std::chrono::steady_clock::now();
     const std::vector<vision::ObservedTag> tags = observer_.Observe(image);
     ms_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    last_frame_ = frame.pixels;
+    last_size_ = {frame.width, frame.height};
+    last_tags_.clear();
+    for (const vision::ObservedTag& t : tags) last_tags_.push_back(t.detection);
     drivers::TagSightings out;
     for (const vision::ObservedTag& t : tags) {
       const auto& q = t.quaternion;
@@ -90,6 +101,22 @@ class TagSightingsStage : public Stage {
   }
 
  private:
+  // A lift (carrying begins) or a set-down (it ends): the last frame, with its tags drawn.
+  void ForkliftChanged(const drivers::ForkliftStatus& f) {
+    const bool changed = f.carrying != carrying_;
+    carrying_ = f.carrying;
+    if (f.crate_id >= 0) crate_ = f.crate_id;
+    if (!changed || !last_frame_ || output_dir_.empty()) return;
+    const cv::Mat image(last_size_.height, last_size_.width, CV_8UC1, const_cast<uint8_t*>(last_frame_->data()));
+    const std::string name = output_dir_ + "/forklift_" + std::to_string(++snapshots_) + "_" +
+                             (f.carrying ? "lift" : "set_down") + "_crate" + std::to_string(crate_) + ".png";
+    try {
+      vision::WriteImage(vision::DrawTags(image, last_tags_), name);
+    } catch (const std::exception& e) {
+      mbot::log::Warn("tag_sightings: " + std::string(e.what()));
+    }
+  }
+
   TagSightingsOptions o_;
   vision::TagObserver observer_;
   Bus* bus_ = nullptr;
@@ -97,6 +124,12 @@ class TagSightingsStage : public Stage {
   std::vector<double> ms_;
   std::map<int, int64_t> per_id_;
   int64_t frames_ = 0;
+  std::string output_dir_;
+  std::shared_ptr<const std::vector<uint8_t>> last_frame_;
+  cv::Size last_size_;
+  std::vector<vision::TagDetection> last_tags_;
+  bool carrying_ = false;
+  int crate_ = -1, snapshots_ = 0;
 };
 
 }  // namespace

@@ -82,7 +82,9 @@ std::vector<ObservedTag> TagObserver::Observe(const cv::Mat& image) {
     }
     ObservedTag t;
     t.detection = d;
-    t.camera = EstimateTagPose(d, options_.tag_size_m, camera_, options_.pose_method);
+    const cv::Vec3d down = mount_R.t() * cv::Vec3d(0, 0, -1);  // the world's down in the camera frame
+    t.camera =
+        EstimateTagPose(d, options_.tag_size_m, camera_, options_.pose_method, options_.upright_tags ? &down : nullptr);
     t.quaternion = QuaternionOf(t.camera.R);
     t.robot_position = mount_R * t.camera.t + mount_t;
     t.robot_bearing_rad = std::atan2(t.robot_position[1], t.robot_position[0]);

@@ -48,7 +48,7 @@ std::array<cv::Point3d, 4> TagCornersInTagFrame(double tag_size_m) {
 }
 
 TagPose EstimateTagPose(const TagDetection& tag, double tag_size_m, const CameraIntrinsics& camera,
-                        TagPoseMethod method) {
+                        TagPoseMethod method, const cv::Vec3d* down) {
   if (!(tag_size_m > 0)) throw std::invalid_argument("tag pose: tag size must be positive");
   const std::array<cv::Point3d, 4> object = TagCornersInTagFrame(tag_size_m);
   TagPose pose;
@@ -56,10 +56,22 @@ TagPose EstimateTagPose(const TagDetection& tag, double tag_size_m, const Camera
     // IPPE_SQUARE wants the corners as (-h, h), (h, h), (h, -h), (-h, -h): the detector's order.
     std::vector<cv::Point3d> obj(object.begin(), object.end());
     std::vector<cv::Point2d> img(tag.corners.begin(), tag.corners.end());
-    cv::Vec3d rvec, tvec;
-    cv::solvePnP(obj, img, camera.K, camera.distortion, rvec, tvec, false, cv::SOLVEPNP_IPPE_SQUARE);
-    cv::Rodrigues(rvec, pose.R);
-    pose.t = tvec;
+    std::vector<cv::Mat> rvecs, tvecs;
+    cv::Mat errors;
+    const int n = cv::solvePnPGeneric(obj, img, camera.K, camera.distortion, rvecs, tvecs, false,
+                                      cv::SOLVEPNP_IPPE_SQUARE, cv::noArray(), cv::noArray(), errors);
+    int pick = 0;  // IPPE sorts its two solutions by reprojection error
+    if (down && n == 2) {
+      auto uprightness = [&](int k) {
+        cv::Matx33d R;
+        cv::Rodrigues(rvecs[k], R);
+        return (R * cv::Vec3d(0, 1, 0)).dot(*down);  // the tag's y axis against the world's down
+      };
+      const double e0 = errors.at<double>(0), e1 = errors.at<double>(1);
+      if (uprightness(1) > uprightness(0) && (e1 <= 2 * e0 || e1 <= e0 + 0.3)) pick = 1;
+    }
+    cv::Rodrigues(rvecs[pick], pose.R);
+    pose.t = cv::Vec3d(tvecs[pick].at<double>(0), tvecs[pick].at<double>(1), tvecs[pick].at<double>(2));
   } else {
     const std::vector<cv::Point2d> corners = Undistorted(tag, camera);
     apriltag_detection_t det{};

@@ -53,6 +53,9 @@ TagObserverOptions ParseTagObserverOptions(config::Section& s, const TagObserver
       "pose_method", d.pose_method == TagPoseMethod::kIppeSquare ? "ippe_square" : "apriltag",
       {"ippe_square", "apriltag"}, "tag pose: OpenCV's solvePnP IPPE_SQUARE or the reference library's estimator");
   o.pose_method = method == "ippe_square" ? TagPoseMethod::kIppeSquare : TagPoseMethod::kAprilTagLibrary;
+  o.upright_tags = s.GetBool("upright_tags", d.upright_tags,
+                             "the tags are upright on vertical faces: of the two poses that fit a small tag seen "
+                             "face on, take the upright one");
   o.mount = ParseCameraMount(s, d.mount);
   return o;
 }

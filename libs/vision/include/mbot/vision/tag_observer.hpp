@@ -32,6 +32,9 @@ struct TagObserverOptions {
   double tag_size_m = 0.054;  // the black square's side (the botlab's crate tags are 54 mm)
   std::vector<int> ids;       // the ids to report (empty: every id the family has)
   TagPoseMethod pose_method = TagPoseMethod::kIppeSquare;
+  // The tags are upright on vertical faces (crates): of IPPE's two poses take the upright one when
+  // both fit (EstimateTagPose).
+  bool upright_tags = false;
   CameraMount mount;
 };
 

@@ -25,9 +25,13 @@ struct TagPose {
   double reprojection_error_px = 0.0;  // RMS over the four corners, through the full camera model
 };
 
-// Throws std::invalid_argument when tag_size_m is not positive.
+// Throws std::invalid_argument when tag_size_m is not positive. With `down` (the world's down in
+// the camera frame, unit) and IPPE_SQUARE, the tag is known to be upright (printed on a vertical
+// face, its y axis pointing down): of IPPE's two poses — a small tag seen face on fits both almost
+// equally — the more upright one is taken unless its reprojection error is more than twice the
+// other's (and 0.3 px above it).
 TagPose EstimateTagPose(const TagDetection& tag, double tag_size_m, const CameraIntrinsics& camera,
-                        TagPoseMethod method);
+                        TagPoseMethod method, const cv::Vec3d* down = nullptr);
 
 // The tag's corners in its own frame, in the order the detector reports them.
 std::array<cv::Point3d, 4> TagCornersInTagFrame(double tag_size_m);
