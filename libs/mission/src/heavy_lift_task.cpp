@@ -1,8 +1,9 @@
-// Heavy Lift: for each (crate, crate to stack it on) of the day, in order — find the crate by its
-// tag, drive (A* with SLAM) to a stand-off square to one of its faces, look (fresh sightings refine
-// where the crate is), line up, drive the tines in along the face's normal by servoing on the
-// crate's estimated pose, lift, back off; then the same to the crate it goes on, with the carried
-// crate held above it, set it down, back off. Home at the end.
+// Heavy Lift: one turn on the spot to see the crates; then for each (crate, crate to stack it on) of
+// the day, in order — find the crate by its tag (one not seen yet is looked for from round the
+// crates seen), drive (A* with SLAM) to a stand-off square to one of its faces, look (fresh
+// sightings refine where the crate is), line up, drive the tines in along the face's normal by
+// servoing on the crate's estimated pose, lift, back off; then the same to the crate it goes on,
+// with the carried crate held above it, set it down, back off. Home at the end.
 //
 // Where a crate is comes from the camera only: each sighting (tag centre and facing, robot frame,
 // at the frame's time) is put in the map frame with the robot's pose then, and the crate's centre
@@ -63,14 +64,15 @@ class CrateEstimate {
 
 enum class Phase {
   kStart,
-  kSurvey,      // one turn on the spot at the start: see every crate around
-  kFind,        // turn on the spot until the crate of the step is seen
-  kToStandOff,  // A* to the stand-off before a face
-  kLook,        // stand still, gather sightings, check the line-up
-  kIn,          // servo along the face's normal: tines in (pick) or carried crate over (place)
-  kLift,        // tines up: the crate is lifted
-  kSetDown,     // tines down: the crate is set on the other
-  kOut,         // back off along the line
+  kSurvey,       // one turn on the spot at the start: see every crate around
+  kToViewpoint,  // A* to a place to look for a crate not seen yet
+  kFind,         // turn on the spot until the crate of the step is seen
+  kToStandOff,   // A* to the stand-off before a face
+  kLook,         // stand still, gather sightings, check the line-up
+  kIn,           // servo along the face's normal: tines in (pick) or carried crate over (place)
+  kLift,         // tines up: the crate is lifted
+  kSetDown,      // tines down: the crate is set on the other
+  kOut,          // back off along the line
   kHome,
   kDone,
 };
@@ -118,11 +120,11 @@ class HeavyLiftTask : public Task {
           m.Drive(0.0, o_.search_turn_rad_s);
           return false;
         }
-        phase_ = Phase::kFind;
-        turned_ = 0;
+        phase_ = Phase::kFind;  // a crate not seen in this turn is looked for elsewhere (Search)
         break;
       case Phase::kFind: return Find(m, pose);
       case Phase::kToStandOff: return true;  // the controller drives; Arrived moves on
+      case Phase::kToViewpoint: return true;
       case Phase::kLook: return Look(m, pose);
       case Phase::kIn: return In(m, pose);
       case Phase::kLift: return Lift(m);
@@ -137,6 +139,12 @@ class HeavyLiftTask : public Task {
 
   void Arrived(Mission& m, const std::string& how) override {
     m.EndFinalLeg();
+    if (phase_ == Phase::kToViewpoint) {  // there: a turn on the spot
+      phase_ = Phase::kFind;
+      turned_ = 0;
+      turn_from_here_ = true;
+      return;
+    }
     if (phase_ == Phase::kHome) {
       phase_ = Phase::kDone;
       m.SetState(MissionState::kCompleted, std::to_string(stacked_) + " of " + std::to_string(o_.stack.size()) +
@@ -149,7 +157,8 @@ class HeavyLiftTask : public Task {
   }
 
   void Stalled(Mission& m) override {
-    if (phase_ == Phase::kToStandOff) {
+    if (phase_ == Phase::kToViewpoint) --viewpoint_;  // that viewpoint again, from where the back-off ends
+    if (phase_ == Phase::kToStandOff || phase_ == Phase::kToViewpoint) {
       phase_ = Phase::kFind;  // plan again from where the back-off ends
       phase_us_ = m.now_us();
     }
@@ -194,27 +203,71 @@ class HeavyLiftTask : public Task {
     m.Hold();
   }
 
-  bool Find(Mission& m, const Pose2D& pose) {
-    auto it = crates_.find(target());
-    if (it == crates_.end() || !it->second.known()) {
-      // Turn on the spot, two turns at most.
-      turned_ += std::abs(motion::WrapAngle(pose.theta - last_theta_));
-      last_theta_ = pose.theta;
-      if (turned_ > 4 * M_PI) {
-        Fail(m, Name() + ": its tag was not seen in two turns on the spot");
-        return false;
-      }
-      m.SetState(MissionState::kExploring, "looking for " + Name());
-      m.Drive(0.0, o_.search_turn_rad_s);
-      return false;
-    }
-    if (!m.map() || (no_path_since_us_ >= 0 && failed_map_ == m.map())) {
-      m.Hold();  // no map yet, or the one no path was found in: wait for the next
-      return false;
-    }
+  // The planner on the latest map; false (holding) while there is none.
+  bool PlannerReady(Mission& m) {
+    if (!m.map()) return false;
     if (!planner_.has_map() || planned_map_ != m.map()) {
       planner_.SetMap(planning::ObstacleDistanceGrid(*m.map(), distance_));
       planned_map_ = m.map();
+    }
+    return true;
+  }
+
+  // A crate not seen yet: it may be hidden behind another or too far to read. Turn on the spot,
+  // then go round the crates seen (the day's crates to lift stand in one area): a viewpoint 0.8 m
+  // from their centre, first on the robot's side, then a quarter turn round either way, then the
+  // far side; a turn on the spot at each.
+  bool Search(Mission& m, const Pose2D& pose) {
+    if (turn_from_here_) last_theta_ = pose.theta, turn_from_here_ = false;
+    if (turned_ < 2 * M_PI) {
+      turned_ += std::abs(motion::WrapAngle(pose.theta - last_theta_));
+      last_theta_ = pose.theta;
+      m.SetState(MissionState::kExploring, "looking for " + Name() + " (turning on the spot)");
+      m.Drive(0.0, o_.search_turn_rad_s);
+      return false;
+    }
+    double cx = 0, cy = 0;
+    int n = 0;
+    for (const auto& [first, second] : o_.stack) {  // the crates to lift that were seen, else any
+      auto it = crates_.find(first);
+      if (first != carried_ && it != crates_.end() && it->second.known())
+        cx += it->second.Get().x, cy += it->second.Get().y, ++n;
+    }
+    for (const auto& [id, e] : crates_) {
+      if (n == 0 && id != carried_ && e.known()) cx += e.Get().x, cy += e.Get().y, ++n;
+    }
+    if (n == 0 || !PlannerReady(m)) {
+      if (n == 0)
+        Fail(m, Name() + ": no crate seen in a turn on the spot");
+      else
+        m.Hold();
+      return false;
+    }
+    if (n > 0) cx /= n, cy /= n;
+    const double away = std::atan2(pose.y - cy, pose.x - cx);
+    const double offsets[] = {0.0, kQuarter, -kQuarter, M_PI};
+    while (viewpoint_ < 4) {
+      const double a = away + offsets[viewpoint_++];
+      const Pose2D goal{cx + 0.8 * std::cos(a), cy + 0.8 * std::sin(a), motion::WrapAngle(a + M_PI)};
+      const planning::PlanResult r = planner_.PlanSteppingOut(pose, goal);
+      if (r.status != planning::PlanStatus::kFound) continue;
+      m.SetGoal(goal);
+      m.SetPath(r.path);
+      m.SetState(MissionState::kExploring, "looking for " + Name() + " from another side of the crates");
+      phase_ = Phase::kToViewpoint;
+      return true;
+    }
+    Fail(m, Name() + ": its tag was not seen from the start or from round the crates");
+    return false;
+  }
+
+  bool Find(Mission& m, const Pose2D& pose) {
+    auto it = crates_.find(target());
+    if (it == crates_.end() || !it->second.known()) return Search(m, pose);
+    viewpoint_ = 0;
+    if ((no_path_since_us_ >= 0 && failed_map_ == m.map()) || !PlannerReady(m)) {
+      m.Hold();  // no map yet, or the one no path was found in: wait for the next
+      return false;
     }
     // The face towards the robot first, then the others by how far round the crate they are.
     const Pose2D c = it->second.Get();
@@ -415,8 +468,10 @@ class HeavyLiftTask : public Task {
   std::pair<int64_t, double> progress_;
   bool out_started_ = false, just_set_down_ = false;
   int64_t no_path_since_us_ = -1;
-  double fork_cmd_ = -1;  // the tines' height commanded last
-  double turned_ = 0, last_theta_ = 0;
+  int viewpoint_ = 0;                   // viewpoints tried while looking for the crate of this step
+  double fork_cmd_ = -1;                // the tines' height commanded last
+  double turned_ = 0, last_theta_ = 0;  // turning on the spot: how far so far, the heading last step
+  bool turn_from_here_ = false;
   Pose2D home_;
 };
 
