@@ -66,7 +66,7 @@ enum class Phase {
   kStart,
   kSurvey,       // one turn on the spot at the start: see every crate around
   kToViewpoint,  // A* to a place to look for a crate not seen yet
-  kFind,         // turn on the spot until the crate of the step is seen
+  kFind,         // plan to a stand-off before the crate of the step (look for it first if unseen)
   kToStandOff,   // A* to the stand-off before a face
   kLook,         // stand still, gather sightings, check the line-up
   kIn,           // servo along the face's normal: tines in (pick) or carried crate over (place)
