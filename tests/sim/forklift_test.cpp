@@ -228,7 +228,7 @@ TEST(Forklift, SimRobotPublishesStatusAndCrates) {
   }
   const double seconds = (t + 3'000'000) * 1e-6;
   EXPECT_NEAR(statuses, 10 * seconds, 4);  // 10 Hz, and one more at each change
-  EXPECT_EQ(crate_messages, 3);            // the start, engaged, lifted
+  EXPECT_EQ(crate_messages, 4);            // the start, engaged, carried, clear of the floor
   ASSERT_TRUE(last && crates);
   EXPECT_EQ(last->crate_id, 5);
   EXPECT_TRUE(last->carrying);
