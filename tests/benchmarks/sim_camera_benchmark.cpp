@@ -1,10 +1,11 @@
 // The simulated camera (libs/sim SimCamera) and the tag pose on its frames (Google Benchmark):
 //  - BM_SimCameraRender: one 640 x 480 frame of an arena with three crates in view (sensor noise,
 //    blur and exposure change on), time per frame;
-//  - BM_TagPoseError/<range_cm>/<angle_deg>/<upright>: a crate's tag seen from range_cm (camera to
-//    tag) with the crate turned angle_deg, 20 frames each with their own noise and a lateral offset
-//    up to ±5 cm; each frame through the reference detector (default settings) and IPPE_SQUARE
-//    (upright 1: upright_tags, the more upright of IPPE's two poses when both fit); counters
+//  - BM_TagPoseError/<range_cm>/<angle_deg>/<upright>/<blur>: a crate's tag seen from range_cm
+//    (camera to tag) with the crate turned angle_deg, 20 frames each with their own noise and a
+//    lateral offset up to ±5 cm; each frame through the reference detector (default settings, but
+//    blur_sigma = blur / 10 px) and IPPE_SQUARE (upright 1: upright_tags, the more upright of IPPE's
+//    two poses when both fit); counters
 //    recall, median and worst position error of the tag's centre [cm] and of its heading [deg]
 //    against the simulator's truth. Time: detection + pose per frame.
 // The camera: fx = fy = 530, 640 x 480, 20 cm up, pitched 20 degrees down, 5 cm ahead of the axle
@@ -64,6 +65,7 @@ void BM_TagPoseError(benchmark::State& st) {
   oo.tag_size_m = o.tag_size_m;
   oo.mount = o.mount;
   oo.upright_tags = st.range(2) != 0;
+  oo.detector.blur_sigma = st.range(3) / 10.0;
   mbot::vision::TagObserver observer(oo, camera.options().intrinsics);
   // Frames: the crate's near face `range` ahead of the camera (horizontally), offset sideways.
   struct Frame {
@@ -116,7 +118,7 @@ void BM_TagPoseError(benchmark::State& st) {
 BENCHMARK(BM_SimCameraRender)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SimCameraScene)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_TagPoseError)
-    ->ArgsProduct({{20, 40, 60, 80, 100}, {0, 20, 40}, {0, 1}})
+    ->ArgsProduct({{20, 40, 60, 80, 100}, {0, 20, 40}, {1}, {0, 8}})
     ->Iterations(1)
     ->Unit(benchmark::kMillisecond);
 
