@@ -63,13 +63,8 @@ void Mission::OnTags(int64_t t_us, const std::vector<TagSeen>& tags) {
 }
 
 bool Mission::PoseAt(int64_t t_us, Pose2D* pose) const {
-  if (!has_slam_ || odometry_.empty()) return false;
-  Pose2D odo_slam, odo_then;
-  if (!motion::InterpolateAt(odometry_, slam_.t_us, 200'000, &odo_slam) ||
-      !motion::InterpolateAt(odometry_, t_us, 200'000, &odo_then))
-    return false;
-  *pose = slam_.pose.Compose(odo_slam.Inverse().Compose(odo_then));
-  return true;
+  Pose2D odo_then;
+  return motion::InterpolateAt(odometry_, t_us, 200'000, &odo_then) && FromOdometry(odo_then, pose);
 }
 
 void Mission::CommandFork(double height_m) {
@@ -136,12 +131,14 @@ std::vector<MissionOutput> Mission::OnOdometry(int64_t t_us, const Pose2D& raw_o
 }
 
 // The pose now: the SLAM pose at its scan, moved on by what odometry says happened since.
-bool Mission::PoseNow(Pose2D* pose) const {
+bool Mission::PoseNow(Pose2D* pose) const { return !odometry_.empty() && FromOdometry(odometry_.back().pose, pose); }
+
+// The SLAM pose moved on by odometry from the SLAM pose's time to where odometry says `odometry`.
+bool Mission::FromOdometry(const Pose2D& odometry, Pose2D* pose) const {
   if (!has_slam_ || odometry_.empty()) return false;
-  Pose2D odo_then;
-  if (!motion::InterpolateAt(odometry_, slam_.t_us, 200'000, &odo_then)) return false;
-  const Pose2D delta = odo_then.Inverse().Compose(odometry_.back().pose);
-  *pose = slam_.pose.Compose(delta);
+  Pose2D odo_slam;
+  if (!motion::InterpolateAt(odometry_, slam_.t_us, 200'000, &odo_slam)) return false;
+  *pose = slam_.pose.Compose(odo_slam.Inverse().Compose(odometry));
   return true;
 }
 

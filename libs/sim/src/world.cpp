@@ -610,6 +610,9 @@ std::vector<std::pair<double, double>> Crate::Outline(double step_m) const {
 }
 
 bool Crate::Overlaps(const Crate& other) const {
+  // Each footprint lies within its half-diagonal of its centre: farther apart, they cannot touch.
+  const double reach = 0.5 * (std::hypot(width_m, depth_m) + std::hypot(other.width_m, other.depth_m));
+  if (std::hypot(pose.x - other.pose.x, pose.y - other.pose.y) > reach) return false;
   for (const auto& [x, y] : Outline(0.002)) {
     if (other.DistanceTo(x, y) <= 0.0) return true;
   }

@@ -74,6 +74,7 @@ std::vector<ObservedTag> TagObserver::Observe(const cv::Mat& image) {
   std::vector<ObservedTag> out;
   const cv::Matx33d mount_R = options_.mount.Rotation();
   const cv::Vec3d mount_t = options_.mount.Translation();
+  const cv::Vec3d down = mount_R.t() * cv::Vec3d(0, 0, -1);  // the world's down in the camera frame
   for (const TagDetection& d : detector_.Detect(image)) {
     const std::vector<int>& ids = options_.ids;
     if (!ids.empty() && std::find(ids.begin(), ids.end(), d.id) == ids.end()) {
@@ -82,7 +83,6 @@ std::vector<ObservedTag> TagObserver::Observe(const cv::Mat& image) {
     }
     ObservedTag t;
     t.detection = d;
-    const cv::Vec3d down = mount_R.t() * cv::Vec3d(0, 0, -1);  // the world's down in the camera frame
     t.camera =
         EstimateTagPose(d, options_.tag_size_m, camera_, options_.pose_method, options_.upright_tags ? &down : nullptr);
     t.quaternion = QuaternionOf(t.camera.R);

@@ -176,6 +176,7 @@ class Mission {
 
  private:
   bool PoseNow(motion::Pose2D* pose) const;
+  bool FromOdometry(const motion::Pose2D& odometry, motion::Pose2D* pose) const;
   bool Recovering();
   bool Settled(const motion::Pose2D& pose, std::string* how);
   motion::VelocityCommand MeasuredVelocity() const;

@@ -6,15 +6,16 @@
 //
 // Rays come from the camera model (intrinsics and distortion, e.g. a camera.yaml): each pixel's
 // ray is its undistorted direction, so the image is distorted as the real lens would distort it
-// and the tags appear under their true projection. Pixels on a tag or on a crate's outline are the
-// mean of 2 × 2 rays (edges anti-aliased as a real sensor's area sampling makes them); the rest use
-// one ray. The camera must be below the walls' top.
+// and the tags appear under their true projection. Pixels on a crate's outline or a tag's cell edge
+// are the mean of 2 × 2 rays (edges anti-aliased as a real sensor's area sampling makes them); the
+// rest use one ray. The camera must be below the walls' top.
 // Walls and floor are plain; each crate face and wall is lit by its direction to a fixed light.
 // Then the sensor: an exposure gain drawn per frame, Gaussian blur, Gaussian noise.
 //
 // Speed: the walls are found per frame by one ray cast per column of angles (all surfaces are
 // vertical or horizontal, and the robot only moves in the plane, so each pixel's direction in the
-// robot frame is fixed and computed once).
+// robot frame is fixed and computed once); a crate is cast only over the box round its projected
+// corners.
 #pragma once
 
 #include <cstdint>
