@@ -230,11 +230,15 @@ class HeavyLiftTask : public Task {
     int n = 0;
     for (const auto& [first, second] : o_.stack) {  // the crates to lift that were seen, else any
       auto it = crates_.find(first);
-      if (first != carried_ && it != crates_.end() && it->second.known())
-        cx += it->second.Get().x, cy += it->second.Get().y, ++n;
+      if (first == carried_ || it == crates_.end() || !it->second.known()) continue;
+      const Pose2D c = it->second.Get();
+      cx += c.x, cy += c.y, ++n;
     }
+    const bool lift_crates_seen = n > 0;
     for (const auto& [id, e] : crates_) {
-      if (n == 0 && id != carried_ && e.known()) cx += e.Get().x, cy += e.Get().y, ++n;
+      if (lift_crates_seen || id == carried_ || !e.known()) continue;
+      const Pose2D c = e.Get();
+      cx += c.x, cy += c.y, ++n;
     }
     if (n == 0 || !PlannerReady(m)) {
       if (n == 0)
@@ -243,7 +247,7 @@ class HeavyLiftTask : public Task {
         m.Hold();
       return false;
     }
-    if (n > 0) cx /= n, cy /= n;
+    cx /= n, cy /= n;
     const double away = std::atan2(pose.y - cy, pose.x - cx);
     const double offsets[] = {0.0, kQuarter, -kQuarter, M_PI};
     while (viewpoint_ < 4) {
@@ -428,10 +432,7 @@ class HeavyLiftTask : public Task {
       attempts_ = 0;
     }
     if (job_ == o_.stack.size()) {
-      if (!planner_.has_map() || planned_map_ != m.map()) {
-        planner_.SetMap(planning::ObstacleDistanceGrid(*m.map(), distance_));
-        planned_map_ = m.map();
-      }
+      if (!PlannerReady(m)) return false;
       const planning::PlanResult r = planner_.PlanSteppingOut(pose, home_);
       if (r.status != planning::PlanStatus::kFound) {
         Fail(m, "no path home: " + std::string(planning::ToString(r.status)));
