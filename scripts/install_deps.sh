@@ -15,6 +15,10 @@ packages=(
   zlib1g-dev
   clang-format  # scripts/check_format.sh (ctest format.check)
   iproute2    # the live LCM tests set up loopback multicast in a private network namespace
+  nlohmann-json3-dev  # libs/sweep: the sweep manifest and the jobs' JSON outputs
+  python3             # test scripts' small checks (tests/sweep/maze_sweep.sh)
+  parallel            # sweeps on every local core (GNU parallel; tests/sweep)
+  slurm-wlm munge     # sweeps as a Slurm job array: the test starts a one-node cluster (tests/sweep)
 )
 
 if [ "${1:-}" = --fuzz ]; then

@@ -1,5 +1,6 @@
 // mbot_nav: parse arguments, load the configuration, build the pipeline, run it, report.
 #include <csignal>
+#include <filesystem>
 #include <cstring>
 #include <iostream>
 #include <optional>
@@ -8,6 +9,8 @@
 #include "mbot/common/log.hpp"
 #include "competition.hpp"
 #include "pipeline.hpp"
+#include "mbot/sweep/sweep.hpp"
+#include "sweep_mode.hpp"
 
 namespace {
 
@@ -24,6 +27,8 @@ type = <stage type> and its keys; [source] path = ... is the input; [output] dir
 output. `${datasets}` in a value is the shared datasets folder (MBOT_DATASETS_DIR).
 A FILE with a [competition] section runs several events, each its own pipeline config, and prints
 one score table (config/competition.ini: --set competition.seed=N, --set <event>.world=FILE).
+A FILE with a [sweep] section writes a job list (jobs.txt, sweep.sbatch) for GNU parallel or Slurm
+and runs nothing (config/sweep_mazes.ini); config/merge_sweep.ini merges the jobs' results.
 
 options:
   --config FILE          the INI file (include = other.ini pulls in shared defaults)
@@ -59,6 +64,13 @@ void ListStages() {
     t.create(s);
     describe("stage type " + t.name, t.doc, s);
   }
+}
+
+// The running binary, absolute (the sweep's jobs run this one).
+std::string SelfPath(const char* argv0) {
+  std::error_code ec;
+  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::filesystem::absolute(argv0).string() : self.string();
 }
 
 void ListSources() {
@@ -121,6 +133,10 @@ int main(int argc, char** argv) {
     for (const auto& s : sets) config.Set(s);
     if (print_config) {
       std::cout << config.ToIni();
+      return 0;
+    }
+    if (mbot::sweep::IsSweep(config)) {
+      mbot::app::WriteSweepJobs(config, SelfPath(argv[0]));
       return 0;
     }
     if (mbot::app::IsCompetition(config)) {

@@ -176,7 +176,7 @@ RunSummary RunPlan(PipelinePlan& plan, const std::atomic<bool>& stop) {
   progress.Done();
   for (auto& [name, stage] : plan.stages) stage->Finish(ctx, summary.interrupted);
   summary.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  if (summary.events == 0 && !summary.interrupted && plan.source.type != "none") {
+  if (summary.events == 0 && !summary.interrupted && source->events_expected()) {
     // Nothing passes silently: an empty file, or one whose every record was rejected, is a failed run.
     const drivers::SourceDiagnostics& d = source->diagnostics();
     throw std::runtime_error(plan.source.path + ": no usable event in the input (" + source->Format() + "; " +

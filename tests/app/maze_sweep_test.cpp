@@ -5,9 +5,8 @@
 //   MazeSample (label simulation, the default run): three mazes that once failed — a long corridor
 //     seen only at a slant from its mouth (7), a frontier banded along such a corridor (9), a free
 //     wall end seen faintly and touched (6).
-//   MazeSweep (label mazes: ctest -C mazes -L mazes): mazes MBOT_MAZE_FIRST .. MBOT_MAZE_LAST
-//     (default 1 .. 100), with a table of the results (on stdout, and in build/tests/out/maze_sweep.md
-//     or MBOT_MAZE_SWEEP_MD) — the table in BENCHMARKS.md.
+//   The sweep over mazes 1-100 (label mazes) is config/sweep_mazes.ini, run by
+//     tests/sweep/maze_sweep.sh under GNU parallel and merged into one table.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -54,76 +53,6 @@ TEST_P(MazeSample, ExploredMappedAndHomeWithoutCollision) {
   ExpectExploredMappedAndHome(r.json);
 }
 INSTANTIATE_TEST_SUITE_P(GeneratedMazes, MazeSample, ::testing::Values(6, 7, 9));
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  const size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-int EnvInt(const char* name, int fallback) {
-  const char* v = std::getenv(name);
-  return v && *v ? std::atoi(v) : fallback;
-}
-
-TEST(MazeSweep, EveryGeneratedMazeExploredMappedAndHome) {
-  const int first = EnvInt("MBOT_MAZE_FIRST", 1), last = EnvInt("MBOT_MAZE_LAST", 100);
-  ASSERT_LE(first, last);
-  std::vector<double> coverage, time_s, error_m, rtf, cells;
-  int completed = 0, collisions = 0, runs_with_collision = 0, within = 0;
-  std::string outside;
-  std::ostringstream rows;
-  rows << "| maze | cells | loops | dead ends | longest corridor | state | coverage % | walls % | time s | home error "
-          "m | "
-          "collisions |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
-  for (int seed = first; seed <= last; ++seed) {
-    SCOPED_TRACE("generated maze " + std::to_string(seed));
-    const MazeRun r = ExploreGeneratedMaze(seed);
-    ExpectExploredMappedAndHome(r.json);
-    if (r.json.empty()) continue;
-    const double cov = Get(r.json, {"map", "coverage"}), t = Get(r.json, {"time_s"});
-    const double err = std::hypot(Get(r.json, {"final_error", "x_m"}), Get(r.json, {"final_error", "y_m"}));
-    const int col = static_cast<int>(Get(r.json, {"collisions"}));
-    const bool done = r.json.find("\"completed\": true") != std::string::npos;
-    coverage.push_back(cov), time_s.push_back(t), error_m.push_back(err),
-        rtf.push_back(Get(r.json, {"sim_seconds"}) / r.wall_s);
-    cells.push_back(r.maze.cols * r.maze.rows);
-    completed += done, collisions += col, runs_with_collision += col > 0;
-    const double walls = Get(r.json, {"map", "wall_precision"});
-    if (done && col == 0 && cov >= 0.99 && walls >= 0.95 && err <= 0.05) {
-      ++within;
-    } else {
-      outside += (outside.empty() ? "" : ", ") + std::to_string(seed);
-    }
-    char row[256];
-    std::snprintf(row, sizeof row, "| %d | %dx%d | %d | %d | %d | %s | %.1f | %.1f | %.1f | %.3f | %d |\n", seed,
-                  r.maze.cols, r.maze.rows, r.maze.Loops(), r.maze.DeadEnds(), r.maze.LongestCorridor(),
-                  done ? "completed" : "NOT completed", 100 * cov, 100 * walls, t, err, col);
-    rows << row;
-  }
-  const int n = static_cast<int>(coverage.size());
-  ASSERT_GT(n, 0);
-  char summary[2048];
-  std::snprintf(
-      summary, sizeof summary,
-      "| mazes | within every bound | completed | coverage min / median %% | time median [min, max] s | "
-      "runs with a collision | home error median / max m | real-time factor median |\n"
-      "|---|---|---|---|---|---|---|---|\n"
-      "| %d (seeds %d-%d) | %d (outside: %s) | %d | %.1f / %.1f | %.0f [%.0f, %.0f] | %d | %.3f / %.3f | %.0f |\n",
-      n, first, last, within, outside.empty() ? "none" : outside.c_str(), completed,
-      100 * *std::min_element(coverage.begin(), coverage.end()), 100 * Median(coverage), Median(time_s),
-      *std::min_element(time_s.begin(), time_s.end()), *std::max_element(time_s.begin(), time_s.end()),
-      runs_with_collision, Median(error_m), *std::max_element(error_m.begin(), error_m.end()), Median(rtf));
-  const std::string table = std::string(summary) + "\n" + rows.str();
-  std::cout << table;
-  const char* md = std::getenv("MBOT_MAZE_SWEEP_MD");
-  const std::string md_path = md && *md ? md : ::testing::TempDir() + "/maze_sweep.md";
-  std::filesystem::create_directories(std::filesystem::path(md_path).parent_path());
-  std::ofstream(md_path) << table;
-  EXPECT_EQ(completed, n);
-  EXPECT_EQ(collisions, 0);
-}
 
 }  // namespace
 }  // namespace mbot::app

@@ -1,5 +1,6 @@
 #include "competition.hpp"
 #include "pipeline.hpp"
+#include "sweep_mode.hpp"
 
 #include <gtest/gtest.h>
 
@@ -31,11 +32,12 @@ TEST(PipelineTest, BuildsRegisteredStages) {
 TEST(PipelineTest, UnknownStageTypeListsTheKnownOnes) {
   const auto e = ErrorOf(std::string(kBase) + "[s]\ntype = nope\n");
   EXPECT_NE(
-      e.find(
-          "t.ini:6: [s] type: unknown stage type 'nope' (known: action_model_fit, astar_test, camera_calibration, "
-          "exploration, "
-          "inspect, lcm_bridge, map_writer, maze_generator, mission, motor_calibration, movingai_benchmark, odometry, "
-          "recorder, referee, slam, tag_detection, tag_sightings, trajectory_writer)"),
+      e.find("t.ini:6: [s] type: unknown stage type 'nope' (known: action_model_fit, astar_test, camera_calibration, "
+             "exploration, "
+             "inspect, lcm_bridge, map_writer, maze_generator, merge_sweep, mission, motor_calibration, "
+             "movingai_benchmark, "
+             "odometry, "
+             "recorder, referee, slam, tag_detection, tag_sightings, trajectory_writer)"),
       std::string::npos)
       << e;
 }
@@ -75,7 +77,8 @@ TEST(PipelineTest, AnEmptyInputFailsTheRun) {
   EXPECT_THROW(RunPlan(dir_plan, stop), std::runtime_error);
 }
 
-// Every shipped configuration parses strictly (keys, sections, stage types, values). A fragment
+// Every shipped configuration parses strictly (keys, sections, stage types, values; a sweep's every
+// job). A fragment
 // (no [pipeline] and no [competition]: defaults.ini, warehouse_day.ini) is checked through the
 // configs that include it, and must be included by one.
 TEST(PipelineTest, EveryShippedConfigIsValid) {
@@ -88,6 +91,11 @@ TEST(PipelineTest, EveryShippedConfigIsValid) {
     std::ifstream in(entry.path());
     all_text += std::string(std::istreambuf_iterator<char>(in), {});
     const config::Config c = config::Config::Load(entry.path().string());
+    if (sweep::IsSweep(c)) {  // every job's own configuration is built too
+      EXPECT_NO_THROW(BuildSweep(c, "/bin/true"));
+      ++n;
+      continue;
+    }
     if (entry.path().filename() == "defaults.ini" || (!c.HasSection("pipeline") && !IsCompetition(c))) {
       fragments.push_back(entry.path().filename().string());
       continue;

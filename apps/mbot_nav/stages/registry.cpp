@@ -1,6 +1,7 @@
 #include <algorithm>
 
 #include "mbot/sim/sim_source.hpp"
+#include "mbot/sweep/sweep_source.hpp"
 #include "stages.hpp"
 
 namespace mbot::app {
@@ -24,14 +25,18 @@ const std::vector<StageType>& StageTypes() {
                                 MazeGeneratorStageType(),
                                 CameraCalibrationStageType(),
                                 TagDetectionStageType(),
-                                TagSightingsStageType()};
+                                TagSightingsStageType(),
+                                MergeSweepStageType()};
     std::sort(t.begin(), t.end(), [](const StageType& a, const StageType& b) { return a.name < b.name; });
     return t;
   }();
   return types;
 }
 
-void RegisterSources() { sim::RegisterSimSource(); }
+void RegisterSources() {
+  sim::RegisterSimSource();
+  sweep::RegisterSweepSource();
+}
 
 const StageType* FindStageType(const std::string& name) {
   for (const auto& t : StageTypes()) {

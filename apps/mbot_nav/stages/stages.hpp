@@ -23,5 +23,6 @@ StageType MazeGeneratorStageType();
 StageType CameraCalibrationStageType();
 StageType TagDetectionStageType();
 StageType TagSightingsStageType();
+StageType MergeSweepStageType();
 
 }  // namespace mbot::app

@@ -188,6 +188,14 @@ Section Section::Describe(std::string name) { return Section(std::move(name), nu
 
 bool Section::Has(const std::string& key) const { return entries_ && entries_->count(key) > 0; }
 
+std::vector<std::string> Section::Keys() const {
+  std::vector<std::string> keys;
+  if (entries_) {
+    for (const auto& [key, entry] : *entries_) keys.push_back(key);
+  }
+  return keys;
+}
+
 void Section::Accept(const std::string& key) { known_.push_back(key); }
 
 void Section::Fail(const std::string& key, const std::string& message) const {

@@ -122,6 +122,7 @@ class NoSource : public Source {
   std::optional<Event> Next() override { return std::nullopt; }
   double Progress() const override { return 1.0; }
   std::string Format() const override { return "no input"; }
+  bool events_expected() const override { return false; }
 };
 
 // libs/drivers' own types; detect_order < 0 may name a folder, the others need a regular file.
@@ -272,13 +273,14 @@ std::unique_ptr<Source> OpenSource(const SourceOptions& options) {
   const std::string type = options.type == "auto" ? DetectFormat(options.path) : options.type;
   const SourceType* t = FindSourceType(type);
   if (!t) throw std::runtime_error("source type '" + type + "' is not known");
-  // Only the A* cases come as a folder; a folder anywhere else would read as an empty file. A
-  // camera's path may be a device index or a pipeline: it checks its own.
+  // Only the A* cases and a sweep come as a folder; a folder anywhere else would read as an empty
+  // file. A camera's path may be a device index or a pipeline: it checks its own.
   const bool bus = type == "lcm_live" || type == "lcm_relay" || type == "none" || type == "camera";
-  if (type != "astar_cases" && !bus && std::filesystem::is_directory(options.path)) {
+  const bool folder = type == "astar_cases" || type == "sweep";
+  if (!folder && !bus && std::filesystem::is_directory(options.path)) {
     throw std::runtime_error(options.path + ": is a directory, not a " + type + " file");
   }
-  if (type != "astar_cases" && !bus && !options.path.empty()) RequireReadableFile(options.path);
+  if (!folder && !bus && !options.path.empty()) RequireReadableFile(options.path);
   return t->open(options);
 }
 

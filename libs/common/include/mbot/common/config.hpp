@@ -135,6 +135,9 @@ class Section {
   }
 
   bool Has(const std::string& key) const;
+  // The keys the section holds (sorted), for sections whose keys are names the user chose (a
+  // sweep's axis values). Reading one with a getter still marks it known.
+  std::vector<std::string> Keys() const;
   // Marks a key as known without reading it (e.g. `type`, which the registry consumed).
   void Accept(const std::string& key);
   // Throws ConfigError for the first key that no getter asked for, listing the known keys.

@@ -45,6 +45,9 @@ class Source {
   // Where the stack's outputs go when the input is a robot (the simulator, live LCM) — the source
   // itself — or nullptr for a recorded dataset.
   virtual Sink* sink() { return nullptr; }
+  // False for inputs that are no event stream (type none, a sweep folder): a run of no event is
+  // then not a failed run.
+  virtual bool events_expected() const { return true; }
   // Format-specific facts for summaries, e.g. {"sensory frames", "37"}.
   virtual std::vector<std::pair<std::string, std::string>> Details() const { return {}; }
   const std::map<std::string, ChannelInfo>& channels() const { return channels_; }
