@@ -35,7 +35,11 @@ array() {  # folder: submits its array and waits for it; prints the wall time
   local t0 job
   t0=$(now)
   job=$(sbatch --parsable "$1/sweep.sbatch")
-  while [ -n "$(squeue -h -j "$job" 2> /dev/null)" ]; do sleep 0.2; done
+  local i
+  for i in $(seq 1 36000); do  # two hours at most
+    [ -n "$(squeue -h -j "$job")" ] || break
+    sleep 0.2
+  done
   secs "$t0" "$(now)"
 }
 t_slurm=$(array "$work/slurm")

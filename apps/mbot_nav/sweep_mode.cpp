@@ -23,15 +23,16 @@ SweepPlan BuildSweep(const config::Config& config, const std::string& binary) {
   // (A generated maze's arena does not exist yet; its source is then checked by extension only.)
   std::map<std::string, config::Config> loaded;
   for (const sweep::Job& job : jobs) {
-    const std::vector<std::string>& run = job.runs.back();
-    try {
-      auto it = loaded.find(run[3]);
-      if (it == loaded.end()) it = loaded.emplace(run[3], config::Config::Load(run[3])).first;
-      config::Config c = it->second;
-      for (size_t k = 4; k + 1 < run.size(); k += 2) c.Set(run[k + 1]);
-      BuildPlan(c);
-    } catch (const std::exception& e) {
-      throw config::ConfigError(spec.sweep_file + ": job " + job.id + " would fail: " + e.what());
+    for (const std::vector<std::string>& run : job.runs) {  // a maze's generation, then the run itself
+      try {
+        auto it = loaded.find(run[3]);
+        if (it == loaded.end()) it = loaded.emplace(run[3], config::Config::Load(run[3])).first;
+        config::Config c = it->second;
+        for (size_t k = 4; k + 1 < run.size(); k += 2) c.Set(run[k + 1]);
+        BuildPlan(c);
+      } catch (const std::exception& e) {
+        throw config::ConfigError(spec.sweep_file + ": job " + job.id + " would fail: " + e.what());
+      }
     }
   }
   return plan;

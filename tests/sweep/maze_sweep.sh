@@ -7,13 +7,14 @@ set -uo pipefail
 bin=$1 src=$2 out=$3
 first=${MBOT_MAZE_FIRST:-1} last=${MBOT_MAZE_LAST:-100}
 cd "$src" || exit 1
+parallel --version 2> /dev/null | grep -q "GNU parallel" || { echo "FAIL: GNU parallel is not installed"; exit 1; }
 rm -rf "$out"
 "$bin" --config config/sweep_mazes.ini --set sweep.mazes="$first-$last" --set output.dir="$out" || exit 1
 start=$(date +%s.%N)
 parallel --retries 3 --joblog "$out/parallel.log" -a "$out/jobs.txt"
 status=$?
 echo "GNU parallel: $(wc -l < "$out/jobs.txt") jobs in $(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }') s wall (exit $status)"
-"$bin" --quiet --config config/merge_sweep.ini --set source.path="$out" || exit 1
+"$bin" --quiet --config config/merge_sweep.ini --set source.path="$out" --set output.dir="$out.merge" || exit 1
 cat "$out/sweep.md"
 python3 - "$out/sweep.csv" <<'PY'
 import csv, math, sys

@@ -5,13 +5,20 @@
 #   source tests/sweep/slurm_cluster.sh; slurm_start DIR CPUS || exit 77; ...; slurm_stop DIR
 # slurm_start exports SLURM_CONF and prints why when a daemon cannot start (returns 1).
 
-slurm_free_port() {
-  python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'
+# Two free ports on 127.0.0.1, found by one process holding both sockets at once (so they differ).
+slurm_free_ports() {
+  python3 -c 'import socket
+s = [socket.socket() for _ in range(2)]
+for x in s: x.bind(("127.0.0.1", 0))
+print(*[x.getsockname()[1] for x in s])'
 }
 
 slurm_start() {
-  local dir=$1 cpus=${2:-2} node
+  local dir=$1 cpus=${2:-2} node mem
   node=$(hostname -s)
+  # The node as this machine is (slurmd refuses to register a node smaller than it is configured).
+  [ "$cpus" -le "$(nproc)" ] || cpus=$(nproc)
+  mem=$(( $(awk '/^MemTotal:/ { print $2 }' /proc/meminfo) / 1024 / 2 ))
   for tool in munged slurmctld slurmd sbatch squeue scontrol; do
     command -v "$tool" > /dev/null || { echo "slurm_start: $tool is not installed (scripts/install_deps.sh)"; return 1; }
   done
@@ -23,8 +30,9 @@ slurm_start() {
       --pid-file="$dir/munge/munged.pid" --log-file="$dir/munge/munged.log" --seed-file="$dir/munge/seed" --force; then
     echo "slurm_start: munged did not start: $(tail -n 3 "$dir/munge/munged.log" 2>/dev/null)"; return 1
   fi
-  local ctl_port dport
-  ctl_port=$(slurm_free_port) && dport=$(slurm_free_port) || { echo "slurm_start: no free port"; return 1; }
+  local ports ctl_port dport
+  ports=$(slurm_free_ports) || { echo "slurm_start: no free port"; return 1; }
+  read -r ctl_port dport <<< "$ports"
   cat > "$dir/slurm.conf" <<CONF
 ClusterName=mbotsweep
 SlurmctldHost=$node(127.0.0.1)
@@ -56,7 +64,7 @@ MpiDefault=none
 JobRequeue=1
 SlurmctldTimeout=30
 SlurmdTimeout=30
-NodeName=$node NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=4000 State=UNKNOWN
+NodeName=$node NodeAddr=127.0.0.1 CPUs=$cpus RealMemory=$mem State=UNKNOWN
 PartitionName=sweep Nodes=$node Default=YES MaxTime=INFINITE State=UP
 CONF
   export SLURM_CONF="$dir/slurm.conf"
@@ -72,10 +80,18 @@ CONF
 }
 
 slurm_stop() {
-  local dir=$1 f
+  local dir=$1 f i
+  [ -f "$dir/slurm.conf" ] && SLURM_CONF="$dir/slurm.conf" scancel --full --quiet --partition=sweep 2> /dev/null
   for f in "$dir/slurmd.pid" "$dir/slurmctld.pid" "$dir/munge/munged.pid"; do
     [ -f "$f" ] && kill "$(cat "$f")" 2> /dev/null
   done
-  sleep 0.5
+  for i in $(seq 1 20); do  # until the daemons are gone (at most 10 s)
+    local alive=0
+    for f in "$dir/slurmd.pid" "$dir/slurmctld.pid" "$dir/munge/munged.pid"; do
+      [ -f "$f" ] && kill -0 "$(cat "$f")" 2> /dev/null && alive=1
+    done
+    [ $alive = 0 ] && break
+    sleep 0.5
+  done
   return 0
 }

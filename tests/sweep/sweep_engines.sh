@@ -27,7 +27,7 @@ merge() {  # folder jobs
 }
 
 if [ "$part" = local ]; then
-  command -v parallel > /dev/null || fail "GNU parallel is not installed (scripts/install_deps.sh)"
+  parallel --version 2> /dev/null | grep -q "GNU parallel" || fail "GNU parallel is not installed (scripts/install_deps.sh)"
   expand "$work/serial" 1-3 6
   bash "$work/serial/jobs.txt" > "$work/serial.log" 2>&1 || fail "a serial job failed: $(tail -n 3 "$work/serial.log")"
   merge "$work/serial" 6
@@ -77,14 +77,20 @@ merge "$work/parallel" 8
 job=$(sbatch --parsable "$work/slurm/sweep.sbatch" 2> "$work/sbatch.log") \
   || fail "sbatch: $(cat "$work/sbatch.log"); $(tail -n 5 "$slurm_dir/log/slurmctld.log")"
 start=$(date +%s.%N)
+queued() {  # the array's tasks still queued or running; fails the test when squeue cannot answer
+  local out
+  out=$(squeue -h -j "$job" 2>&1) || fail "squeue: $out"
+  [ -n "$out" ]
+}
 for i in $(seq 1 600); do
-  [ -z "$(squeue -h -j "$job" 2> /dev/null)" ] && break
+  queued || break
   sleep 0.5
 done
-[ -z "$(squeue -h -j "$job" 2> /dev/null)" ] || fail "the array is still queued after 5 minutes: $(squeue)"
+queued && fail "the array is still queued after 5 minutes: $(squeue)"
 echo "Slurm: 8 array tasks of job $job in $(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { printf "%.1f", b - a }') s"
-failed=$(grep -L '^0$' "$work"/slurm/jobs/*/exit_status | wc -l)
-[ "$failed" = 0 ] || fail "$failed array tasks failed"
+for d in "$work"/slurm/jobs/*/; do
+  grep -q '^0 ' "$d/exit_status" 2> /dev/null || fail "job $(basename "$d") did not end well: $(tail -n 2 "$d/job.log")"
+done
 [ "$(ls "$work/slurm/slurm" | wc -l)" = 8 ] || fail "Slurm ran $(ls "$work/slurm/slurm" | wc -l) array tasks, not 8"
 merge "$work/slurm" 8
 diff "$work/serial/sweep.md" "$work/slurm/sweep.md" || fail "the Slurm array's table differs from the serial run's"

@@ -154,6 +154,20 @@ TEST_F(SweepTest, MistakesNameTheKey) {
   EXPECT_NE(error(head + "metrics = metrics.ate\n").find("metrics"), std::string::npos);
   EXPECT_NE(error("[sweep]\nconfig = ${config_dir}/missing.ini\n").find("no such file"), std::string::npos);
   EXPECT_NE(error(head + "cases = c\n[c]\nbad/name = a.b=1\n").find("bad/name"), std::string::npos);
+  EXPECT_NE(error(head + "slurm_time = 1 hour\n").find("slurm_time"), std::string::npos);
+  EXPECT_NE(error(head + "maze_config = ${config_dir}/generate.ini\nmazes = 3000000000\n").find("2147483647"),
+            std::string::npos);
+  EXPECT_NE(error(head + "[output]\ndir = a%b\n").find("[output] dir"), std::string::npos);
+}
+
+TEST_F(SweepTest, ValueNamesThatRunIntoEachOtherAreRefused) {
+  const SweepSpec spec = Parse("[sweep]\nconfig = ${config_dir}/base.ini\ngrid = a.x=1_a.y-2,1; a.y=3,2_a.y-3\n");
+  try {
+    ExpandJobs(spec);
+    ADD_FAILURE() << "two jobs of one id";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("are both called a.x-1_a.y-2_a.y-3"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(SweepTest, TheLineSkipsACompleteJobAndRecordsAFailedOne) {
@@ -161,18 +175,26 @@ TEST_F(SweepTest, TheLineSkipsACompleteJobAndRecordsAFailedOne) {
   const Job job = ExpandJobs(spec).at(0);
   std::string out;
   EXPECT_EQ(Bash(job.command, &out), 0);
-  EXPECT_EQ(Slurp(job.dir + "/exit_status"), "0\n");
+  EXPECT_EQ(Slurp(job.dir + "/exit_status").substr(0, 2), "0 ");
   EXPECT_NE(Slurp(job.dir + "/job.log").find("running seed 5"), std::string::npos);
   EXPECT_EQ(Bash(job.command, &out), 0);
   EXPECT_EQ(out, "seed-5: complete, skipped\n");
   fs::remove(job.dir + "/score.json");  // outputs incomplete: runs again, and fails this time
   Write(dir_ + "/fail", "");
   EXPECT_EQ(Bash(job.command, &out), 1);
-  EXPECT_EQ(Slurp(job.dir + "/exit_status"), "3\n");
+  EXPECT_EQ(Slurp(job.dir + "/exit_status").substr(0, 2), "3 ");
   EXPECT_NE(Slurp(job.dir + "/job.log").find("boom"), std::string::npos);
   fs::remove(dir_ + "/fail");
   EXPECT_EQ(Bash(job.command, &out), 0);  // a failed job is not "complete"
   EXPECT_TRUE(fs::exists(job.dir + "/score.json"));
+  EXPECT_EQ(Bash(job.command, &out), 0);
+  EXPECT_EQ(out, "seed-5: complete, skipped\n");
+  // An edited base config makes the recorded result another command's: the job runs again.
+  Write(dir_ + "/base.ini", "[pipeline]\nstages = edited\n");
+  const Job edited = ExpandJobs(spec).at(0);
+  EXPECT_NE(edited.command, job.command);
+  EXPECT_EQ(Bash(edited.command, &out), 0);
+  EXPECT_EQ(out, "") << out;
 }
 
 TEST_F(SweepTest, WritesTheListTheArrayAndTheManifest) {

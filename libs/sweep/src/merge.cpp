@@ -238,7 +238,9 @@ MergeSummary MergeSweep(const std::string& dir, const std::string& into) {
     for (const std::string& c : columns) {
       for (const JobResult& r : jobs) {
         if (auto it = r.values.find(c); it != r.values.end()) {
-          if (it->second.is_number) metrics.push_back(c);
+          // Wall-clock figures would make the table depend on the machine and the engine.
+          const bool wall = c.find("wall") != std::string::npos || c.find("real_time_factor") != std::string::npos;
+          if (it->second.is_number && !wall) metrics.push_back(c);
           break;
         }
       }
@@ -248,7 +250,7 @@ MergeSummary MergeSweep(const std::string& dir, const std::string& into) {
   md << "# Sweep " << manifest.value("name", std::string("?")) << ": " << jobs.size() << " jobs, " << summary.failed
      << " failed, " << summary.not_run << " not run\n\n"
      << "Each cell: median [min, max] over the jobs that completed (yes/no metrics: how many of them).\n\n";
-  md << "| axis | value | jobs | failed |";
+  md << "| axis | value | jobs | failed or not run |";
   for (const std::string& m : metrics) md << " " << Md(m) << " |";
   md << "\n|---|---|---|---|";
   for (size_t k = 0; k < metrics.size(); ++k) md << "---|";
@@ -323,7 +325,11 @@ MergeSummary MergeSweep(const std::string& dir, const std::string& into) {
     po.title = m + (axes.empty() ? "" : " by " + axes[0]);
     po.x_label = axes.empty() ? "job" : axes[0];
     po.y_label = m;
-    EnsureDirectory(into + "/plots");
+    if (summary.written.size() == 2) {  // the first plot: last merge's plots go (a metric may be gone)
+      std::error_code ec;
+      fs::remove_all(into + "/plots", ec);
+      EnsureDirectory(into + "/plots");
+    }
     const std::string path = into + "/plots/" + PlotName(m);
     drivers::WritePlotPng({dots, median}, po, path);
     summary.written.push_back(path);

@@ -1,6 +1,9 @@
 #include "mbot/sweep/sweep.hpp"
 
 #include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <map>
 #include <filesystem>
 #include <set>
 #include <sstream>
@@ -10,6 +13,7 @@
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/config.hpp"
+#include "mbot/common/log.hpp"
 #include "mbot/common/strings.hpp"
 
 namespace fs = std::filesystem;
@@ -71,6 +75,30 @@ void CheckUnique(config::Section& s, const std::string& key, const Axis& axis) {
   }
 }
 
+// What makes a job's recorded result its own: FNV-1a over its runs' words and the text of every
+// configuration they name (an edited base config or another binary re-runs the job).
+std::string JobStamp(const std::vector<std::vector<std::string>>& runs) {
+  uint64_t h = 1469598103934665603ull;
+  auto add = [&](const std::string& text) {
+    for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
+    h = (h ^ 0xff) * 1099511628211ull;
+  };
+  for (const auto& run : runs) {
+    for (size_t k = 0; k < run.size(); ++k) {
+      add(run[k]);
+      if (k > 0 && run[k - 1] == "--config") {
+        std::ifstream in(run[k], std::ios::binary);
+        std::ostringstream text;
+        text << in.rdbuf();
+        add(text.str());
+      }
+    }
+  }
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
 void WriteText(const std::string& path, const std::string& text) {
   WriteFileAtomically(path, [&](std::ostream& f) { f << text; });
 }
@@ -124,18 +152,21 @@ SweepSpec ParseSweep(const config::Config& config, const std::string& binary, co
   config::Section s = config.GetSection("sweep");
   spec.base_config =
       Absolute(s.GetPath("config", "", "the base configuration every job runs (an INI a single run takes)"), workdir);
-  spec.maze_config = Absolute(
-      s.GetPath("maze_config", "${config_dir}/generate_mazes.ini",
-                "the maze generator's configuration (its style); each job of the maze axis generates its maze"),
-      workdir);
+  spec.maze_config =
+      Absolute(s.GetPath("maze_config", (fs::path(spec.sweep_file).parent_path() / "generate_mazes.ini").string(),
+                         "the maze generator's configuration (its style; default: generate_mazes.ini beside the sweep "
+                         "config); each job of the maze axis generates its maze"),
+               workdir);
   spec.world_key = s.GetString("world_key", spec.world_key, "the key a generated maze, a world or a log is set to");
   spec.seed_key = s.GetString("seed_key", spec.seed_key, "the key a seed is set to");
   const std::string mazes = s.GetString("mazes", "", "generated-maze axis: maze seeds, e.g. 1-100 or 1-6, 9");
-  const std::vector<std::string> worlds = s.GetList("worlds", {}, "world axis: arena or map files");
-  const std::vector<std::string> logs = s.GetList("logs", {}, "log axis: datasets (LCM, CARMEN, rawlog, ...)");
+  // Paths and grids expand ${datasets} and ${config_dir} like every path key.
+  const std::vector<std::string> worlds = SplitTrimmed(s.GetPath("worlds", "", "world axis: arena or map files"), ',');
+  const std::vector<std::string> logs =
+      SplitTrimmed(s.GetPath("logs", "", "log axis: datasets (LCM, CARMEN, rawlog, ...)"), ',');
   const std::string seeds = s.GetString("seeds", "", "seed axis: seeds, e.g. 1-10 (none: the base config's seed)");
   const std::string grid =
-      s.GetString("grid", "", "--set grids: 'section.key=v1,v2,...' axes separated by ';' (every combination)");
+      s.GetPath("grid", "", "--set grids: 'section.key=v1,v2,...' axes separated by ';' (every combination)");
   const std::vector<std::string> cases =
       s.GetList("cases", {}, "axis sections: each key of one is a value, `name = [config=<ini>;] s.k=v; ...`");
   const std::string set_text = s.GetPath("set", "", "overrides of every job, section.key=value separated by ';'");
@@ -160,6 +191,14 @@ SweepSpec ParseSweep(const config::Config& config, const std::string& binary, co
                                 "i, i+T, ... (short jobs: fewer tasks, less scheduling)",
                                 1, 100000));
   s.Finish();
+  for (auto [key, value] : {std::pair{"slurm_partition", &spec.slurm.partition},
+                            {"slurm_time", &spec.slurm.time_limit},
+                            {"slurm_mem", &spec.slurm.memory},
+                            {"slurm_job_name", &spec.slurm.job_name}}) {
+    if (value->find_first_of(" \t\r\n%\"'\\") != std::string::npos) {
+      s.Fail(key, "'" + *value + "' has a space, quote, backslash or %: it cannot stand in an #SBATCH line");
+    }
+  }
   if (spec.base_config.empty()) s.Fail("config", "required key is missing (the base configuration)");
   if (!fs::is_regular_file(spec.base_config)) s.Fail("config", spec.base_config + ": no such file");
   if (spec.outputs.empty()) s.Fail("outputs", "names no file");
@@ -182,6 +221,10 @@ SweepSpec ParseSweep(const config::Config& config, const std::string& binary, co
     spec.output_dir =
         Absolute(o.GetPath("dir", "out/" + spec.name, "the sweep folder: the job list, and jobs/<id>/"), workdir);
     o.Finish();
+    // Slurm reads --output unquoted and expands % in it; a job line is one line of jobs.txt.
+    if (spec.output_dir.find_first_of(" \t\r\n%") != std::string::npos) {
+      o.Fail("dir", "'" + spec.output_dir + "' has a space or %: Slurm's #SBATCH --output cannot hold it");
+    }
   }
   for (const std::string& item : SplitTrimmed(set_text, ';')) {
     CheckAssignment(s, "set", item);
@@ -195,7 +238,11 @@ SweepSpec ParseSweep(const config::Config& config, const std::string& binary, co
     if (!fs::is_regular_file(spec.maze_config)) s.Fail("maze_config", spec.maze_config + ": no such file");
     Axis a{"maze", AxisKind::kMaze, {}};
     try {
-      for (uint64_t m : ParseRanges(mazes)) a.values.push_back({std::to_string(m), {}, "", m});
+      for (uint64_t m : ParseRanges(mazes)) {
+        // The maze generator's seeds are ints (maze_generator first_seed).
+        if (m > 2147483647u) throw std::invalid_argument("maze " + std::to_string(m) + " is above 2147483647");
+        a.values.push_back({std::to_string(m), {}, "", m});
+      }
     } catch (const std::invalid_argument& e) {
       s.Fail("mazes", e.what());
     }
@@ -313,7 +360,7 @@ std::vector<Job> ExpandJobs(const SweepSpec& spec) {
       const std::string world = job.dir + "/world";
       job.runs.push_back({spec.binary, "--quiet", "--config", spec.maze_config, "--set",
                           "mazes.first_seed=" + maze->name, "--set", "mazes.count=1", "--set", "mazes.png=false",
-                          "--set", "output.dir=" + world});
+                          "--set", "mazes.basename=maze", "--set", "output.dir=" + world});
       // The world key first: a case or grid value may still override it.
       sets.insert(sets.begin(), spec.world_key + "=" + world + "/maze_" + maze->name + ".arena");
     }
@@ -321,13 +368,24 @@ std::vector<Job> ExpandJobs(const SweepSpec& spec) {
     for (const std::string& s : sets) run.insert(run.end(), {"--set", s});
     run.insert(run.end(), {"--set", "pipeline.progress=off", "--set", "output.dir=" + job.dir});
     job.runs.push_back(run);
+    for (const auto& r : job.runs) {
+      for (const std::string& w : r) {
+        if (w.find_first_of("\n\r\t") != std::string::npos) {
+          throw std::invalid_argument("job " + job.id + ": '" + w +
+                                      "' holds a line break or tab (a job is one line of jobs.txt)");
+        }
+      }
+    }
+    if (job.id.size() > 200) throw std::invalid_argument("job id " + job.id + " is over 200 characters");
 
-    // The line: skip when complete (exit status 0 recorded and every output there), else run with
-    // the log in the job's folder, record the exit status, and exit with it.
+    // The line: skip when complete (exit status 0 recorded by this very command, with configs of the
+    // same text, and every output there), else run with the log in the job's folder, record the exit
+    // status with the stamp, and exit with it.
+    const std::string stamp = JobStamp(job.runs);
     const std::string q = ShellQuote(job.dir);
     std::ostringstream line;
     line << "cd " << ShellQuote(spec.workdir) << " && export OMP_NUM_THREADS=" << spec.threads << " && if [ \"$(cat "
-         << q << "/exit_status 2>/dev/null)\" = 0 ]";
+         << q << "/exit_status 2>/dev/null)\" = '0 " << stamp << "' ]";
     for (const std::string& o : spec.outputs) line << " && [ -f " << q << "/" << ShellQuote(o) << " ]";
     line << "; then echo " << ShellQuote(job.id + ": complete, skipped") << "; else mkdir -p " << q << " && rm -f " << q
          << "/exit_status && {";
@@ -335,16 +393,26 @@ std::vector<Job> ExpandJobs(const SweepSpec& spec) {
       line << (r ? " &&" : "");
       for (const std::string& w : job.runs[r]) line << " " << ShellQuote(w);
     }
-    line << "; } > " << q << "/job.log 2>&1; s=$?; echo $s > " << q << "/exit_status; [ $s = 0 ]; fi";
+    line << "; } > " << q << "/job.log 2>&1; s=$?; echo \"$s " << stamp << "\" > " << q
+         << "/exit_status; [ $s = 0 ]; fi";
     job.command = line.str();
     jobs.push_back(std::move(job));
+  }
+  std::map<std::string, size_t> ids;
+  for (size_t k = 0; k < jobs.size(); ++k) {
+    if (auto [it, fresh] = ids.emplace(jobs[k].id, k); !fresh) {
+      throw std::invalid_argument("jobs " + std::to_string(it->second + 1) + " and " + std::to_string(k + 1) +
+                                  " are both called " + jobs[k].id +
+                                  " (value names with '_' or '-' run into each other): rename a value");
+    }
   }
   return jobs;
 }
 
 std::string EngineCommands(const SweepSpec& spec) {
   const std::string d = ShellQuote(spec.output_dir);
-  const std::string jobs = spec.threads > 1 ? " -j $(( $(nproc) / " + std::to_string(spec.threads) + " ))" : "";
+  const std::string t = std::to_string(spec.threads);
+  const std::string jobs = spec.threads > 1 ? " -j $(( $(nproc) >= " + t + " ? $(nproc) / " + t + " : 1 ))" : "";
   return "  GNU parallel (all cores): parallel" + jobs + " --retries " + std::to_string(spec.retries + 1) +
          " --joblog " + d + "/parallel.log -a " + d + "/jobs.txt\n" + "  Slurm (job array):        sbatch " + d +
          "/sweep.sbatch\n" + "  one after another:        bash " + d + "/jobs.txt\n" +
@@ -388,6 +456,11 @@ void WriteSweep(const SweepSpec& spec, const std::vector<Job>& jobs) {
   const std::string d = spec.output_dir;
   const size_t per = static_cast<size_t>(spec.slurm.lines_per_task);
   const size_t tasks = std::max<size_t>(1, (jobs.size() + per - 1) / per);
+  if (tasks > 1000) {
+    log::Warn("sweep: sweep.sbatch is an array of " + std::to_string(tasks) +
+              " tasks, past Slurm's default MaxArraySize (1001); raise [sweep] slurm_lines_per_task if the cluster "
+              "keeps that default");
+  }
   std::ostringstream sb;
   sb << "#!/bin/bash\n"
      << "# Slurm job array over " << jobs.size() << " jobs of " << spec.sweep_file << ".\n"
