@@ -75,13 +75,7 @@ CompetitionPlan BuildCompetition(const config::Config& config) {
     const std::string set_text =
         e.GetString("set", "", "section.key=value overrides of the event's configuration, separated by ';'");
     e.Finish();
-    std::vector<std::string> sets;
-    for (size_t b = 0; b <= set_text.size();) {
-      const size_t end = std::min(set_text.find(';', b), set_text.size());
-      const std::string item = Trim(set_text.substr(b, end - b));
-      if (!item.empty()) sets.push_back(item);
-      b = end + 1;
-    }
+    const std::vector<std::string> sets = SplitTrimmed(set_text, ';');
     if (!world.empty() && !std::filesystem::exists(world)) e.Fail("world", world + ": no such file");
     config::Config event;
     try {

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mbot/common/atomic_file.hpp"
+#include "mbot/common/files.hpp"
 #include "mbot/common/strings.hpp"
 #include "mbot/drivers/plot.hpp"
 
@@ -39,9 +40,18 @@ struct JobResult {
   std::map<std::string, Value> values;  // "<stem>.<path>" -> leaf
 };
 
+// What the merge reads: the manifest (WriteSweep's sweep.json) and each job's results.
+struct SweepResults {
+  std::string name;
+  std::vector<std::string> axes, outputs, metrics;
+  std::vector<std::vector<std::string>> axis_values;  // per axis, in the manifest's order
+  std::vector<JobResult> jobs;
+  std::vector<std::string> columns;  // every leaf of any job's outputs, in first-seen order
+};
+
 std::string ReadFile(const std::string& path) {
+  RequireReadableFile(path);
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path + ": cannot be read");
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
@@ -73,6 +83,13 @@ void Flatten(const json& j, const std::string& prefix, std::vector<std::string>*
   } else if (j.is_string()) {
     put({NAN, j.get<std::string>(), false, false});
   }
+}
+
+// The job's value of `metric` when it is a finite number (or a yes/no), else nullptr.
+const Value* NumberOf(const JobResult& job, const std::string& metric) {
+  auto it = job.values.find(metric);
+  if (it == job.values.end() || !it->second.is_number || !std::isfinite(it->second.number)) return nullptr;
+  return &it->second;
 }
 
 std::string LastLogLine(const std::string& path) {
@@ -123,10 +140,10 @@ std::string Cell(const std::vector<const JobResult*>& jobs, const std::string& m
   std::vector<double> v;
   bool boolean = true;
   for (const JobResult* j : jobs) {
-    auto it = j->values.find(metric);
-    if (it == j->values.end() || !it->second.is_number || !std::isfinite(it->second.number)) continue;
-    v.push_back(it->second.number);
-    boolean = boolean && it->second.boolean;
+    if (const Value* x = NumberOf(*j, metric)) {
+      v.push_back(x->number);
+      boolean = boolean && x->boolean;
+    }
   }
   if (v.empty()) return "–";
   if (boolean) {
@@ -144,54 +161,46 @@ std::string PlotName(const std::string& metric) {
   return out + ".png";
 }
 
-}  // namespace
-
-bool IsSweepFolder(const std::string& dir) {
-  std::error_code ec;
-  return fs::is_directory(dir, ec) && fs::is_regular_file(fs::path(dir) / "sweep.json", ec);
-}
-
-MergeSummary MergeSweep(const std::string& dir, const std::string& into) {
-  const std::string manifest_path = (fs::path(dir) / "sweep.json").string();
-  const json manifest = ReadJson(manifest_path);
-  std::vector<std::string> axes, outputs, metrics;
-  std::vector<std::vector<std::string>> axis_values;
-  std::vector<JobResult> jobs;
+SweepResults ReadManifest(const std::string& dir) {
+  const std::string path = (fs::path(dir) / "sweep.json").string();
+  const json manifest = ReadJson(path);
+  SweepResults r;
   try {
+    r.name = manifest.value("name", std::string("?"));
     for (const json& a : manifest.at("axes")) {
-      axes.push_back(a.at("name").get<std::string>());
-      axis_values.push_back(a.at("values").get<std::vector<std::string>>());
+      r.axes.push_back(a.at("name").get<std::string>());
+      r.axis_values.push_back(a.at("values").get<std::vector<std::string>>());
     }
-    outputs = manifest.at("outputs").get<std::vector<std::string>>();
-    metrics = manifest.at("metrics").get<std::vector<std::string>>();
+    r.outputs = manifest.at("outputs").get<std::vector<std::string>>();
+    r.metrics = manifest.at("metrics").get<std::vector<std::string>>();
     for (const json& j : manifest.at("jobs")) {
-      JobResult r;
-      r.id = j.at("id").get<std::string>();
-      r.dir = j.at("dir").get<std::string>();
-      for (const std::string& a : axes) r.axis_values.push_back(j.at("axes").at(a).get<std::string>());
-      jobs.push_back(std::move(r));
+      JobResult job;
+      job.id = j.at("id").get<std::string>();
+      job.dir = j.at("dir").get<std::string>();
+      for (const std::string& a : r.axes) job.axis_values.push_back(j.at("axes").at(a).get<std::string>());
+      r.jobs.push_back(std::move(job));
     }
   } catch (const json::exception& e) {
-    throw std::runtime_error(manifest_path + ": not a sweep manifest (" + e.what() + ")");
+    throw std::runtime_error(path + ": not a sweep manifest (" + e.what() + ")");
   }
-  // The jobs' folders move with the sweep folder: a folder that is not where the manifest says is
-  // looked for under dir/jobs/<id>.
-  std::vector<std::string> columns;  // every leaf seen, in first-seen order
+  return r;
+}
+
+// Each job's status (exit_status) and, when it ended well, the leaves of its outputs.
+void ReadJobs(const std::string& dir, SweepResults* sweep, MergeSummary* summary) {
   std::set<std::string> seen;
-  MergeSummary summary;
-  summary.jobs = static_cast<int>(jobs.size());
-  for (JobResult& r : jobs) {
+  for (JobResult& r : sweep->jobs) {
+    // The jobs' folders move with the sweep folder: one that is not where the manifest says is
+    // looked for under dir/jobs/<id>.
     if (!fs::is_directory(r.dir)) r.dir = (fs::path(dir) / "jobs" / r.id).string();
     std::ifstream status_file(r.dir + "/exit_status");
     std::string status;
     if (!(status_file >> status)) {
-      r.status = "not run";
-      r.why = "no exit status";
+      r.status = "not run", r.why = "no exit status";
     } else if (status != "0") {
-      r.status = "failed";
-      r.why = "exit status " + status;
+      r.status = "failed", r.why = "exit status " + status;
     }
-    for (const std::string& o : outputs) {
+    for (const std::string& o : sweep->outputs) {
       if (r.status != "ok") break;
       const std::string path = r.dir + "/" + o;
       if (!fs::is_regular_file(path)) {
@@ -202,7 +211,7 @@ MergeSummary MergeSweep(const std::string& dir, const std::string& into) {
         std::vector<std::string> order;
         Flatten(ReadJson(path), o.substr(0, o.size() - 5), &order, &r.values);
         for (const std::string& c : order) {
-          if (seen.insert(c).second) columns.push_back(c);
+          if (seen.insert(c).second) sweep->columns.push_back(c);
         }
       } catch (const std::runtime_error& e) {
         r.status = "failed", r.why = e.what();
@@ -211,21 +220,35 @@ MergeSummary MergeSweep(const std::string& dir, const std::string& into) {
     if (r.status != "ok") {
       r.values.clear();
       r.last_log_line = LastLogLine(r.dir + "/job.log");
-      (r.status == "failed" ? summary.failed : summary.not_run)++;
+      (r.status == "failed" ? summary->failed : summary->not_run)++;
     }
   }
-  // The columns in a stable order: the first job's leaves first, then any later one's.
+  if (sweep->metrics.empty()) {  // every number of the results but the wall-clock ones
+    for (const std::string& c : sweep->columns) {
+      for (const JobResult& r : sweep->jobs) {
+        if (auto it = r.values.find(c); it != r.values.end()) {
+          // Wall-clock figures would make the table depend on the machine and the engine.
+          const bool wall = c.find("wall") != std::string::npos || c.find("real_time_factor") != std::string::npos;
+          if (it->second.is_number && !wall) sweep->metrics.push_back(c);
+          break;
+        }
+      }
+    }
+  }
+}
+
+std::string CsvText(const SweepResults& sweep) {
   std::ostringstream csv;
   csv << "id";
-  for (const std::string& a : axes) csv << "," << Csv(a);
+  for (const std::string& a : sweep.axes) csv << "," << Csv(a);
   csv << ",status,why";
-  for (const std::string& c : columns) csv << "," << Csv(c);
+  for (const std::string& c : sweep.columns) csv << "," << Csv(c);
   csv << "\n";
-  for (const JobResult& r : jobs) {
+  for (const JobResult& r : sweep.jobs) {
     csv << Csv(r.id);
     for (const std::string& v : r.axis_values) csv << "," << Csv(v);
     csv << "," << Csv(r.status) << "," << Csv(r.why);
-    for (const std::string& c : columns) {
+    for (const std::string& c : sweep.columns) {
       csv << ",";
       auto it = r.values.find(c);
       if (it == r.values.end()) continue;
@@ -233,107 +256,111 @@ MergeSummary MergeSweep(const std::string& dir, const std::string& into) {
     }
     csv << "\n";
   }
+  return csv.str();
+}
 
-  if (metrics.empty()) {  // the numbers of the first complete job
-    for (const std::string& c : columns) {
-      for (const JobResult& r : jobs) {
-        if (auto it = r.values.find(c); it != r.values.end()) {
-          // Wall-clock figures would make the table depend on the machine and the engine.
-          const bool wall = c.find("wall") != std::string::npos || c.find("real_time_factor") != std::string::npos;
-          if (it->second.is_number && !wall) metrics.push_back(c);
-          break;
-        }
-      }
-    }
-  }
+std::string MarkdownText(const SweepResults& sweep, const MergeSummary& summary) {
   std::ostringstream md;
-  md << "# Sweep " << manifest.value("name", std::string("?")) << ": " << jobs.size() << " jobs, " << summary.failed
-     << " failed, " << summary.not_run << " not run\n\n"
+  md << "# Sweep " << sweep.name << ": " << sweep.jobs.size() << " jobs, " << summary.failed << " failed, "
+     << summary.not_run << " not run\n\n"
      << "Each cell: median [min, max] over the jobs that completed (yes/no metrics: how many of them).\n\n";
   md << "| axis | value | jobs | failed or not run |";
-  for (const std::string& m : metrics) md << " " << Md(m) << " |";
+  for (const std::string& m : sweep.metrics) md << " " << Md(m) << " |";
   md << "\n|---|---|---|---|";
-  for (size_t k = 0; k < metrics.size(); ++k) md << "---|";
+  for (size_t k = 0; k < sweep.metrics.size(); ++k) md << "---|";
   md << "\n";
-  auto row = [&](const std::string& axis, const std::string& value, const std::vector<const JobResult*>& group) {
+  // One row per group: the whole sweep, then each value of each axis.
+  auto row = [&](const std::string& axis, const std::string& value, int a) {
+    size_t jobs = 0;
     std::vector<const JobResult*> ok;
-    for (const JobResult* j : group) {
-      if (j->status == "ok") ok.push_back(j);
+    for (const JobResult& r : sweep.jobs) {
+      if (a >= 0 && r.axis_values[a] != value) continue;
+      ++jobs;
+      if (r.status == "ok") ok.push_back(&r);
     }
-    md << "| " << Md(axis) << " | " << Md(value) << " | " << group.size() << " | " << group.size() - ok.size() << " |";
-    for (const std::string& m : metrics) md << " " << Cell(ok, m) << " |";
+    md << "| " << Md(axis) << " | " << Md(value) << " | " << jobs << " | " << jobs - ok.size() << " |";
+    for (const std::string& m : sweep.metrics) md << " " << Cell(ok, m) << " |";
     md << "\n";
   };
-  std::vector<const JobResult*> all;
-  for (const JobResult& r : jobs) all.push_back(&r);
-  row("all", "", all);
-  for (size_t a = 0; a < axes.size(); ++a) {
-    for (const std::string& value : axis_values[a]) {
-      std::vector<const JobResult*> group;
-      for (const JobResult& r : jobs) {
-        if (r.axis_values[a] == value) group.push_back(&r);
-      }
-      row(axes[a], value, group);
-    }
+  row("all", "", -1);
+  for (size_t a = 0; a < sweep.axes.size(); ++a) {
+    for (const std::string& value : sweep.axis_values[a]) row(sweep.axes[a], value, static_cast<int>(a));
   }
   if (summary.failed + summary.not_run > 0) {
     md << "\n## Jobs that failed or did not run\n\n| job | status | why | last log line |\n|---|---|---|---|\n";
-    for (const JobResult& r : jobs) {
+    for (const JobResult& r : sweep.jobs) {
       if (r.status != "ok")
         md << "| " << Md(r.id) << " | " << r.status << " | " << Md(r.why) << " | " << Md(r.last_log_line) << " |\n";
     }
   }
+  return md.str();
+}
 
-  EnsureDirectory(into);
-  WriteFileAtomically(into + "/sweep.csv", [&](std::ostream& f) { f << csv.str(); });
-  WriteFileAtomically(into + "/sweep.md", [&](std::ostream& f) { f << md.str(); });
-  summary.written = {into + "/sweep.csv", into + "/sweep.md"};
-
-  // A plot per metric against the first axis (numbers where its values are numbers, else their
-  // position), every job a dot and the median a line.
-  std::vector<double> x_of;
-  if (!axes.empty()) {
+// A plot per metric against the first axis (numbers where its values are numbers, else their
+// position; without axes, the job's position), every job a dot and the median a line. The last
+// merge's plots go first: a metric may be gone.
+void WritePlots(const SweepResults& sweep, const std::string& folder, MergeSummary* summary) {
+  std::error_code ec;
+  fs::remove_all(folder, ec);
+  const bool by_axis = !sweep.axes.empty();
+  std::vector<double> x_of;  // x of each value of the first axis
+  if (by_axis) {
     bool numeric = true;
-    for (const std::string& v : axis_values[0]) {
+    for (const std::string& v : sweep.axis_values[0]) {
       char* end = nullptr;
       const double d = std::strtod(v.c_str(), &end);
       numeric = numeric && end && *end == '\0' && std::isfinite(d);
-      x_of.push_back(numeric ? d : NAN);
+      x_of.push_back(d);
     }
     if (!numeric) {
       for (size_t i = 0; i < x_of.size(); ++i) x_of[i] = static_cast<double>(i + 1);
     }
   }
-  for (const std::string& m : metrics) {
+  for (const std::string& m : sweep.metrics) {
     drivers::PlotSeries dots, median;
     dots.points = true, dots.b = 200, dots.label = "job";
     median.r = 220, median.label = "median";
-    for (size_t i = 0; i < (axes.empty() ? size_t{1} : axis_values[0].size()); ++i) {
+    for (size_t i = 0; i < (by_axis ? sweep.axis_values[0].size() : size_t{1}); ++i) {
       std::vector<double> ys;
-      for (size_t k = 0; k < jobs.size(); ++k) {
-        const JobResult& r = jobs[k];
-        if (!axes.empty() && r.axis_values[0] != axis_values[0][i]) continue;
-        auto it = r.values.find(m);
-        if (it == r.values.end() || !it->second.is_number || !std::isfinite(it->second.number)) continue;
-        const double x = axes.empty() ? static_cast<double>(k + 1) : x_of[i];
-        dots.x.push_back(x), dots.y.push_back(it->second.number), ys.push_back(it->second.number);
+      for (size_t k = 0; k < sweep.jobs.size(); ++k) {
+        const JobResult& r = sweep.jobs[k];
+        if (by_axis && r.axis_values[0] != sweep.axis_values[0][i]) continue;
+        if (const Value* v = NumberOf(r, m)) {
+          dots.x.push_back(by_axis ? x_of[i] : static_cast<double>(k + 1)), dots.y.push_back(v->number);
+          ys.push_back(v->number);
+        }
       }
-      if (!ys.empty() && !axes.empty()) median.x.push_back(x_of[i]), median.y.push_back(Median(ys));
+      if (!ys.empty() && by_axis) median.x.push_back(x_of[i]), median.y.push_back(Median(ys));
     }
     if (dots.x.empty()) continue;
     drivers::PlotOptions po;
-    po.title = m + (axes.empty() ? "" : " by " + axes[0]);
-    po.x_label = axes.empty() ? "job" : axes[0];
+    po.title = m + (by_axis ? " by " + sweep.axes[0] : "");
+    po.x_label = by_axis ? sweep.axes[0] : "job";
     po.y_label = m;
-    if (summary.written.size() == 2) {  // the first plot: last merge's plots go (a metric may be gone)
-      std::error_code ec;
-      fs::remove_all(into + "/plots", ec);
-      EnsureDirectory(into + "/plots");
-    }
-    const std::string path = into + "/plots/" + PlotName(m);
+    EnsureDirectory(folder);
+    const std::string path = folder + "/" + PlotName(m);
     drivers::WritePlotPng({dots, median}, po, path);
-    summary.written.push_back(path);
+    summary->written.push_back(path);
   }
+}
+
+}  // namespace
+
+bool IsSweepFolder(const std::string& dir) {
+  std::error_code ec;
+  return fs::is_directory(dir, ec) && fs::is_regular_file(fs::path(dir) / "sweep.json", ec);
+}
+
+MergeSummary MergeSweep(const std::string& dir, const std::string& into) {
+  SweepResults sweep = ReadManifest(dir);
+  MergeSummary summary;
+  summary.jobs = static_cast<int>(sweep.jobs.size());
+  ReadJobs(dir, &sweep, &summary);
+  EnsureDirectory(into);
+  WriteFileAtomically(into + "/sweep.csv", [&](std::ostream& f) { f << CsvText(sweep); });
+  WriteFileAtomically(into + "/sweep.md", [&](std::ostream& f) { f << MarkdownText(sweep, summary); });
+  summary.written = {into + "/sweep.csv", into + "/sweep.md"};
+  WritePlots(sweep, into + "/plots", &summary);
   return summary;
 }
 

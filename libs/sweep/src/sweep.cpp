@@ -28,18 +28,6 @@ std::string Absolute(const std::string& path, const std::string& base) {
   return p.lexically_normal().string();
 }
 
-// "a; b;; c" -> {"a", "b", "c"}
-std::vector<std::string> SplitTrimmed(const std::string& text, char sep) {
-  std::vector<std::string> out;
-  for (size_t b = 0; b <= text.size();) {
-    const size_t end = std::min(text.find(sep, b), text.size());
-    const std::string item = Trim(text.substr(b, end - b));
-    if (!item.empty()) out.push_back(item);
-    b = end + 1;
-  }
-  return out;
-}
-
 // A value name fit for a folder name: letters, digits, '.', '-', '+'; anything else becomes '_'.
 std::string PlainName(const std::string& text) {
   std::string out;
@@ -236,12 +224,12 @@ SweepSpec ParseSweep(const config::Config& config, const std::string& binary, co
     s.Fail(!logs.empty() ? "logs" : "worlds", "mazes, worlds and logs all set " + spec.world_key + ": give one");
   if (!mazes.empty()) {
     if (!fs::is_regular_file(spec.maze_config)) s.Fail("maze_config", spec.maze_config + ": no such file");
-    Axis a{"maze", AxisKind::kMaze, {}};
+    Axis a{"maze", true, {}};
     try {
       for (uint64_t m : ParseRanges(mazes)) {
         // The maze generator's seeds are ints (maze_generator first_seed).
         if (m > 2147483647u) throw std::invalid_argument("maze " + std::to_string(m) + " is above 2147483647");
-        a.values.push_back({std::to_string(m), {}, "", m});
+        a.values.push_back({std::to_string(m), {}, ""});
       }
     } catch (const std::invalid_argument& e) {
       s.Fail("mazes", e.what());
@@ -249,14 +237,13 @@ SweepSpec ParseSweep(const config::Config& config, const std::string& binary, co
     CheckUnique(s, "mazes", a);
     spec.axes.push_back(a);
   }
-  for (auto [key, files, name, kind] :
-       {std::tuple{"worlds", &worlds, "world", AxisKind::kWorld}, std::tuple{"logs", &logs, "log", AxisKind::kLog}}) {
+  for (auto [key, files, name] : {std::tuple{"worlds", &worlds, "world"}, std::tuple{"logs", &logs, "log"}}) {
     if (files->empty()) continue;
-    Axis a{name, kind, {}};
+    Axis a{name, false, {}};
     for (const std::string& f : *files) {
       const std::string path = Absolute(f, workdir);
       if (!fs::exists(path)) s.Fail(key, path + ": no such file");
-      a.values.push_back({PlainName(FileStem(path)), {spec.world_key + "=" + path}, "", 0});
+      a.values.push_back({PlainName(FileStem(path)), {spec.world_key + "=" + path}, ""});
     }
     CheckUnique(s, key, a);
     spec.axes.push_back(a);
@@ -267,9 +254,9 @@ SweepSpec ParseSweep(const config::Config& config, const std::string& binary, co
       s.Fail("cases", "'" + section + "' is listed twice or is a reserved section");
     if (!config.HasSection(section)) s.Fail("cases", "case axis '" + section + "' has no [" + section + "] section");
     config::Section c = config.GetSection(section);
-    Axis a{section, AxisKind::kCase, {}};
+    Axis a{section, false, {}};
     for (const std::string& value : c.Keys()) {
-      AxisValue v{PlainName(value), {}, "", 0};
+      AxisValue v{PlainName(value), {}, ""};
       if (v.name != value) c.Fail(value, "a value name takes letters, digits, '.', '-' and '+' only");
       for (const std::string& item : SplitTrimmed(c.GetPath(value, "", "a value of this axis"), ';')) {
         if (item.rfind("config=", 0) == 0) {
@@ -290,9 +277,9 @@ SweepSpec ParseSweep(const config::Config& config, const std::string& binary, co
     CheckAssignment(s, "grid", item);
     const size_t eq = item.find('=');
     const std::string key = Trim(item.substr(0, eq));
-    Axis a{key, AxisKind::kGrid, {}};
+    Axis a{key, false, {}};
     for (const std::string& value : SplitTrimmed(item.substr(eq + 1), ',')) {
-      a.values.push_back({PlainName(value), {key + "=" + value}, "", 0});
+      a.values.push_back({PlainName(value), {key + "=" + value}, ""});
     }
     if (a.values.empty()) s.Fail("grid", "'" + key + "' has no value");
     if (!names.insert(key).second) s.Fail("grid", "'" + key + "' is a grid axis twice");
@@ -300,10 +287,10 @@ SweepSpec ParseSweep(const config::Config& config, const std::string& binary, co
     spec.axes.push_back(a);
   }
   if (!seeds.empty()) {
-    Axis a{"seed", AxisKind::kSeed, {}};
+    Axis a{"seed", false, {}};
     try {
       for (uint64_t v : ParseRanges(seeds))
-        a.values.push_back({std::to_string(v), {spec.seed_key + "=" + std::to_string(v)}, "", 0});
+        a.values.push_back({std::to_string(v), {spec.seed_key + "=" + std::to_string(v)}, ""});
     } catch (const std::invalid_argument& e) {
       s.Fail("seeds", e.what());
     }
@@ -352,7 +339,7 @@ std::vector<Job> ExpandJobs(const SweepSpec& spec) {
       job.id += (job.id.empty() ? "" : "_") + PlainName(axis.name) + "-" + v.name;
       if (!v.config.empty()) config = v.config;
       sets.insert(sets.end(), v.sets.begin(), v.sets.end());
-      if (axis.kind == AxisKind::kMaze) maze = &v;
+      if (axis.generated_mazes) maze = &v;
     }
     if (job.id.empty()) job.id = "run";
     job.dir = spec.output_dir + "/jobs/" + job.id;

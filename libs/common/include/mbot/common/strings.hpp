@@ -1,8 +1,10 @@
 // Small string helpers the file readers share.
 #pragma once
 
+#include <algorithm>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace mbot {
 
@@ -16,6 +18,18 @@ inline std::string Trim(const std::string& s) {
 // True when `s` ends with `suffix` (file extensions).
 inline bool EndsWith(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// The items of `text` between `sep`s, trimmed, empty ones dropped: "a; b;; c" -> {"a", "b", "c"}.
+inline std::vector<std::string> SplitTrimmed(const std::string& text, char sep) {
+  std::vector<std::string> out;
+  for (size_t b = 0; b <= text.size();) {
+    const size_t end = std::min(text.find(sep, b), text.size());
+    const std::string item = Trim(text.substr(b, end - b));
+    if (!item.empty()) out.push_back(item);
+    b = end + 1;
+  }
+  return out;
 }
 
 // `v` with at most `digits` significant digits, as an ostream prints it ("14.77", "1e+300", "nan"):

@@ -31,17 +31,14 @@ namespace mbot::sweep {
 
 // One value of an axis: its name in job ids and tables, and what it does to a run.
 struct AxisValue {
-  std::string name;               // "7", "1", "300", "maze_1"
+  std::string name;               // "7" (a generated maze's seed), "1", "300", "maze_1"
   std::vector<std::string> sets;  // section.key=value overrides
   std::string config;             // another base config for this value ("" keeps the sweep's)
-  uint64_t maze = 0;              // generated-maze axis: the maze's seed
 };
 
-enum class AxisKind { kMaze, kWorld, kLog, kSeed, kGrid, kCase };
-
 struct Axis {
-  std::string name;  // "maze", "world", "log", "seed", the grid key, the case section
-  AxisKind kind = AxisKind::kCase;
+  std::string name;              // "maze", "world", "log", "seed", the grid key, the case section
+  bool generated_mazes = false;  // each job generates the maze its value names, then runs on it
   std::vector<AxisValue> values;
 };
 
