@@ -1,7 +1,6 @@
 #include "competition.hpp"
 
 #include <cstdio>
-#include <iomanip>
 #include <iostream>
 #include <optional>
 #include <filesystem>
@@ -11,8 +10,9 @@
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/common/strings.hpp"
+#include "mbot/mapping/log_odds_mapper.hpp"
 #include "mbot/sim/hand_out.hpp"
-#include "stages/report.hpp"
+#include "mbot/reports/competition_report.hpp"
 
 namespace mbot::app {
 namespace {
@@ -30,10 +30,7 @@ void HandOutInputs(const std::string& world_path, const std::string& dir, config
   }
 }
 
-struct Row {
-  std::string name, result, outputs;  // the section, what became of it, where its outputs are
-  std::optional<EventResult> scored;  // the referee's result
-};
+using Row = reports::CompetitionRow;
 
 }  // namespace
 
@@ -103,7 +100,7 @@ CompetitionPlan BuildCompetition(const config::Config& config) {
       }
     }
     try {
-      plan.events.push_back({name, BuildPlan(event)});
+      plan.events.push_back({name, pipeline::BuildPlan(event)});
     } catch (const config::ConfigError& err) {
       throw config::ConfigError(config.SectionOrigin(name).ToString() + ": [" + name + "] (config = " + path +
                                 ", with this section's seed, world and set): " + err.what());
@@ -117,7 +114,7 @@ int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
   int status = 0;
   for (CompetitionEvent& e : plan.events) {
     Row r;
-    r.name = e.name;
+    r.section = e.name;
     r.outputs = e.plan.output.dir;
     if (stop.load()) {
       r.result = "not run: interrupted";
@@ -127,7 +124,7 @@ int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
     mbot::log::Info("competition: " + e.name + " (seed " + std::to_string(e.plan.pipeline.seed) + ", world " +
                     e.plan.source.path + ")");
     try {
-      const RunSummary s = RunPlan(e.plan, stop);
+      const pipeline::RunSummary s = pipeline::RunPlan(e.plan, stop);
       r.scored = s.event_result;
       if (r.scored) r.result = s.interrupted ? "interrupted" : r.scored->result;
       if (!r.scored) r.result = "not scored (the referee of " + e.name + " reported no score)";
@@ -140,57 +137,9 @@ int RunCompetition(CompetitionPlan& plan, const std::atomic<bool>& stop) {
     rows.push_back(r);
   }
 
-  int total = 0, max_total = 0;
-  bool incomplete = false;  // an event that should have scored did not
-  std::ostringstream t;
-  t << "\nCompetition on the simulator (Winter 2024 rules)\n"
-    << std::left << std::setw(15) << "event" << std::setw(22) << "arena" << std::setw(6) << "seed" << std::setw(12)
-    << "result" << std::right << std::setw(8) << "time s" << std::setw(11) << "points" << std::setw(6) << "hits"
-    << std::setw(7) << "RTF"
-    << "\n";
-  for (const Row& r : rows) {
-    if (!r.scored) {
-      incomplete = true;
-      t << std::left << std::setw(15) << r.name << r.result << "\n";
-      continue;
-    }
-    const EventResult& e = *r.scored;
-    total += e.points, max_total += e.max_points;
-    t << std::left << std::setw(15) << e.event << std::setw(22) << e.arena.substr(0, 21) << std::setw(6) << e.seed
-      << std::setw(12) << r.result.substr(0, 11) << std::right << std::setw(8) << Num(e.time_s, 4) << std::setw(11)
-      << (std::to_string(e.points) + " / " + std::to_string(e.max_points)) << std::setw(6) << e.collisions
-      << std::setw(6) << Num(e.real_time_factor, 3) << "x\n";
-  }
-  for (const std::string& n : plan.not_run) {
-    const auto colon = n.find(':');
-    t << std::left << std::setw(15) << n.substr(0, colon) << "not run"
-      << (colon == std::string::npos ? "" : ":" + n.substr(colon + 1)) << "\n";
-  }
-  t << std::left << std::setw(63) << "total" << std::right << std::setw(11)
-    << (std::to_string(total) + " / " + std::to_string(max_total))
-    << (incomplete ? "  (incomplete: an event above has no score)" : "") << "\n";
-  std::cout << t.str() << std::flush;
-
-  std::ostringstream j;
-  j << "{\n  \"events\": [";
-  for (size_t i = 0; i < rows.size(); ++i) {
-    const Row& r = rows[i];
-    const std::optional<EventResult>& e = r.scored;
-    auto num = [&](double v, int digits = 6) { return e ? Num(v, digits) : std::string("null"); };
-    j << (i ? "," : "") << "\n    {\"section\": " << JsonString(r.name)
-      << ", \"event\": " << JsonString(e ? e->event : "") << ", \"arena\": " << JsonString(e ? e->arena : "")
-      << ", \"seed\": " << (e ? std::to_string(e->seed) : "null") << ", \"result\": " << JsonString(r.result)
-      << ", \"time_s\": " << num(e ? e->time_s : 0.0, 4) << ", \"points\": " << num(e ? e->points : 0)
-      << ", \"max_points\": " << num(e ? e->max_points : 0) << ", \"collisions\": " << num(e ? e->collisions : 0)
-      << ", \"real_time_factor\": " << num(e ? e->real_time_factor : 0.0, 3)
-      << ", \"outputs\": " << JsonString(r.outputs) << "}";
-  }
-  j << "\n  ],\n  \"not_run\": [";
-  for (size_t i = 0; i < plan.not_run.size(); ++i) j << (i ? ", " : "") << JsonString(plan.not_run[i]);
-  j << "],\n  \"points\": " << total << ",\n  \"max_points\": " << max_total
-    << ",\n  \"complete\": " << (incomplete ? "false" : "true") << "\n}\n";
+  std::cout << reports::CompetitionTable(rows, plan.not_run) << std::flush;
   EnsureDirectory(plan.output_dir);
-  WriteFileAtomically(plan.output_dir + "/competition.json", [&](std::ostream& out) { out << j.str(); });
+  reports::WriteJson(plan.output_dir + "/competition.json", reports::CompetitionJson(rows, plan.not_run));
   return status;
 }
 

@@ -13,13 +13,14 @@
 #include <vector>
 
 #include "mbot/common/config.hpp"
-#include "pipeline.hpp"
+#include "mbot/pipeline/pipeline.hpp"
+#include "stages/stages.hpp"
 
 namespace mbot::app {
 
 struct CompetitionEvent {
   std::string name;  // the section name
-  PipelinePlan plan;
+  pipeline::PipelinePlan plan;
 };
 
 struct CompetitionPlan {

@@ -8,8 +8,10 @@
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
 #include "competition.hpp"
-#include "pipeline.hpp"
+#include "mbot/pipeline/pipeline.hpp"
+#include "mbot/msgs/outputs.hpp"
 #include "mbot/sweep/sweep.hpp"
+#include "stages/stages.hpp"
 #include "sweep_mode.hpp"
 
 namespace {
@@ -36,6 +38,7 @@ options:
   --print-config         print the effective configuration and exit
   --list-stages          list the stage types with their keys and defaults and exit
   --list-sources         list the source types ([source] type) and what each reads, and exit
+  --list-outputs         list the output types ([pipeline] outputs) with their keys, and exit
   --quiet                print warnings and errors only
   --version              print the version and exit
   --help                 this text
@@ -54,15 +57,29 @@ void ListStages() {
     std::cout << "\n";
   };
   {
-    mbot::app::RegisterSources();
     auto s = mbot::config::Section::Describe("source");
-    mbot::drivers::ParseSourceOptions(s);
+    mbot::msgs::ParseSourceOptions(s);
     describe("[source]", "the input dataset (mbot_nav --list-sources for the types)", s);
   }
-  for (const auto& t : mbot::app::StageTypes()) {
-    auto s = mbot::config::Section::Describe(t.name);
-    t.create(s);
-    describe("stage type " + t.name, t.doc, s);
+  for (const mbot::msgs::StageType* t : mbot::msgs::StageTypes()) {
+    auto s = mbot::config::Section::Describe(t->name);
+    t->create(s);
+    describe("stage type " + t->name, t->doc, s);
+  }
+}
+
+void ListOutputs() {
+  std::cout << "[pipeline] outputs = <sections>: each names its type (one of these) and its keys; every output\n"
+               "also takes channels, max_rate_hz, queue_per_kind and when_full.\n\n";
+  for (const mbot::msgs::OutputType* t : mbot::msgs::OutputTypes()) {
+    auto s = mbot::config::Section::Describe(t->name);
+    mbot::msgs::ParseOutputOptions(s, *t);
+    t->create(s);
+    std::cout << "output type " << t->name << "\n    " << t->doc << "\n";
+    for (const auto& k : s.docs()) {
+      std::cout << "    " << k.key << " (" << k.type << ") = " << k.default_value << "\n        " << k.doc << "\n";
+    }
+    std::cout << "\n";
   }
 }
 
@@ -74,14 +91,14 @@ std::string SelfPath(const char* argv0) {
 }
 
 void ListSources() {
-  mbot::app::RegisterSources();
   std::cout << "[source] type = auto detects the type from the path and the file's content; the types:\n";
-  for (const auto& t : mbot::drivers::SourceTypes()) std::cout << "  " << t.name << "\n      " << t.doc << "\n";
+  for (const auto& t : mbot::msgs::SourceTypes()) std::cout << "  " << t.name << "\n      " << t.doc << "\n";
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  mbot::app::RegisterAll();
   std::string config_path;
   std::vector<std::string> sets;
   bool print_config = false;
@@ -114,6 +131,9 @@ int main(int argc, char** argv) {
     } else if (a == "--list-sources") {
       ListSources();
       return 0;
+    } else if (a == "--list-outputs") {
+      ListOutputs();
+      return 0;
     } else if (a == "--quiet") {
       mbot::log::SetLevel(mbot::log::Level::kWarn);
     } else {
@@ -126,7 +146,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  mbot::app::PipelinePlan plan;
+  mbot::pipeline::PipelinePlan plan;
   std::optional<mbot::app::CompetitionPlan> competition;
   try {
     auto config = mbot::config::Config::Load(config_path);
@@ -142,7 +162,7 @@ int main(int argc, char** argv) {
     if (mbot::app::IsCompetition(config)) {
       competition = mbot::app::BuildCompetition(config);
     } else {
-      plan = mbot::app::BuildPlan(config);
+      plan = mbot::pipeline::BuildPlan(config);
     }
   } catch (const mbot::config::ConfigError& e) {
     std::cerr << "mbot_nav: configuration error: " << e.what() << "\n";
@@ -164,7 +184,7 @@ int main(int argc, char** argv) {
     return status;
   }
   try {
-    const auto summary = mbot::app::RunPlan(plan, g_stop);
+    const auto summary = mbot::pipeline::RunPlan(plan, g_stop);
     std::fprintf(stderr,
                  "%s: %lld events, %.1f s of data in %.2f s wall (%.0fx real time), %d warnings; outputs in %s\n",
                  summary.interrupted ? "interrupted" : "done", summary.events, summary.data_seconds,

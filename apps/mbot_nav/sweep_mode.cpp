@@ -5,7 +5,7 @@
 #include <map>
 
 #include "mbot/sweep/sweep.hpp"
-#include "pipeline.hpp"
+#include "mbot/pipeline/pipeline.hpp"
 
 namespace mbot::app {
 
@@ -29,7 +29,7 @@ SweepPlan BuildSweep(const config::Config& config, const std::string& binary) {
         if (it == loaded.end()) it = loaded.emplace(run[3], config::Config::Load(run[3])).first;
         config::Config c = it->second;
         for (size_t k = 4; k + 1 < run.size(); k += 2) c.Set(run[k + 1]);
-        BuildPlan(c);
+        pipeline::BuildPlan(c);
       } catch (const std::exception& e) {
         throw config::ConfigError(spec.sweep_file + ": job " + job.id + " would fail: " + e.what());
       }

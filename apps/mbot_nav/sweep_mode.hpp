@@ -16,7 +16,7 @@ struct SweepPlan {
 };
 
 // Parses the sweep and expands it, and checks every job's configuration as the job's own run will
-// (BuildPlan). Throws config::ConfigError naming the file, section and key (and the job). Writes
+// (pipeline::BuildPlan). Throws config::ConfigError naming the file, section and key (and the job). Writes
 // nothing.
 SweepPlan BuildSweep(const config::Config& config, const std::string& binary);
 

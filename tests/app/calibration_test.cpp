@@ -9,7 +9,7 @@
 #include <tuple>
 
 #include "../regression/run_config.hpp"
-#include "mbot/drivers/lcm_log.hpp"
+#include "mbot/lcm/lcm_log.hpp"
 #include "mbot_lcm_msgs/mbot_encoders_t.hpp"
 #include "mbot_lcm_msgs/mbot_motor_pwm_t.hpp"
 #include "mbot_lcm_msgs/mbot_motor_vel_t.hpp"
@@ -64,7 +64,7 @@ TEST(MotorCalibrationConfig, ShippedCsvFitsTheKnownLines) {
 // A calibration run as an MBot logs it: the duty steps every second through ±0.1 … ±0.5 on both
 // wheels; the wheels follow with a 0.05 s lag (transients the settle time must drop); 50 Hz.
 void WriteCalibrationLog(const std::string& path, double right_encoder_sign) {
-  drivers::LcmLogWriter log(path);
+  lcmio::LcmLogWriter log(path);
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0.0, 0.05);
   const auto steady = [](double duty, const Line& f, const Line& b) {

@@ -95,7 +95,7 @@ INSTANTIATE_TEST_SUITE_P(CratesAndSeeds, HeavyLift,
 class StopAfter : public Stage {
  public:
   StopAfter(std::atomic<bool>* stop, long long n) : stop_(stop), n_(n) {}
-  void OnEvent(const drivers::Event&) override {
+  void OnEvent(const msgs::Event&) override {
     if (++seen_ >= n_) *stop_ = true;
   }
   void Finish(const RunContext&, bool) override {}
@@ -111,10 +111,10 @@ TEST(MazeExplorer, InterruptedRunStillWritesMapTrajectoriesAndScore) {
   std::filesystem::remove_all(out);
   c.Set("output.dir=" + out);
   c.Set("pipeline.progress=off");
-  auto plan = BuildPlan(c);
+  auto plan = pipeline::BuildPlan(c);
   std::atomic<bool> stop{false};
   plan.stages.emplace_back("stop_after", std::make_unique<StopAfter>(&stop, 8000));
-  const RunSummary summary = RunPlan(plan, stop);
+  const pipeline::RunSummary summary = pipeline::RunPlan(plan, stop);
   EXPECT_TRUE(summary.interrupted);
   std::ifstream in(out + "/score.json");
   std::stringstream ss;
@@ -126,13 +126,12 @@ TEST(MazeExplorer, InterruptedRunStillWritesMapTrajectoriesAndScore) {
   }
 }
 
-// A simulated run recorded by the `recorder` stage replays through the LCM log source like a robot's
+// A simulated run recorded by an `lcm_log` output replays through the LCM log source like a robot's
 // log: the same scans, and SLAM on the replay as accurate as it was live (a replay is its own SLAM
 // run with the same seed, so the figures agree within noise, not to the bit).
 TEST(Recording, ASimulatedRunReplaysThroughTheLogSource) {
-  const std::string live =
-      RunConfig("speed_run.ini", "recorded_speed_run",
-                {"pipeline.stages=slam, mission, referee, recorder", "recorder.type=recorder"}, "metrics.json");
+  const std::string live = RunConfig("speed_run.ini", "recorded_speed_run",
+                                     {"pipeline.outputs=record", "record.type=lcm_log"}, "metrics.json");
   ASSERT_FALSE(live.empty());
   const std::string log = ::testing::TempDir() + "/recorded_speed_run/recording.log";
   ASSERT_TRUE(std::filesystem::exists(log));
@@ -143,9 +142,9 @@ TEST(Recording, ASimulatedRunReplaysThroughTheLogSource) {
           "\n[output]\ndir = " + out +
           "\n[slam]\ntype = slam\nmode = full_slam\nparticles = 300\ninitial_pose = origin\n",
       "replay.ini", std::string(MBOT_SOURCE_DIR) + "/config");
-  auto plan = BuildPlan(c);
+  auto plan = pipeline::BuildPlan(c);
   std::atomic<bool> stop{false};
-  RunPlan(plan, stop);
+  pipeline::RunPlan(plan, stop);
   std::ifstream in(out + "/metrics.json");
   std::stringstream ss;
   ss << in.rdbuf();

@@ -2,16 +2,16 @@
 #include <gtest/gtest.h>
 
 #include "mbot/common/config.hpp"
-#include "stage.hpp"
+#include "stages/stages.hpp"
 
 namespace mbot::app {
 namespace {
 
 class CaptureBus : public Bus {
  public:
-  void Emit(const Stage*, const drivers::Event& e) override { events.push_back(e); }
+  void Emit(const Stage*, const msgs::Event& e) override { events.push_back(e); }
   void RequestStop(const std::string&) override {}
-  std::vector<drivers::Event> events;
+  std::vector<msgs::Event> events;
 };
 
 // task = follow (the botlab's motion controller behaviour, live): stand still until a GUI sends a
@@ -19,13 +19,13 @@ class CaptureBus : public Bus {
 TEST(MissionFollow, DrivesThePathAGuiSendsAndStandsStillBefore) {
   auto c = config::Config::FromString("[mission]\ntype = mission\ntask = follow\nstart_delay_s = 0\n");
   config::Section section = c.GetSection("mission");
-  std::unique_ptr<Stage> mission = FindStageType("mission")->create(section);
+  std::unique_ptr<Stage> mission = msgs::FindStageType("mission")->create(section);
   CaptureBus bus;
   RunContext ctx{::testing::TempDir(), 1, nullptr, "", &bus};
   mission->Start(ctx);
-  using drivers::Event;
-  using drivers::EventKind;
-  const motion::Pose2D origin{0, 0, 0};
+  using msgs::Event;
+  using msgs::EventKind;
+  const msgs::Pose2D origin{0, 0, 0};
   mission->OnEvent(Event{0, 0, "SLAM_POSE", EventKind::kPoseEstimate, origin});
   int64_t t = 0;
   auto odometry = [&](double seconds) {
@@ -35,8 +35,7 @@ TEST(MissionFollow, DrivesThePathAGuiSendsAndStandsStillBefore) {
   auto max_speed = [&] {
     double v = 0;
     for (const Event& e : bus.events) {
-      if (e.kind == EventKind::kMotorCommand)
-        v = std::max(v, std::get<drivers::MotorCommand>(e.payload).velocity.v_m_s);
+      if (e.kind == EventKind::kMotorCommand) v = std::max(v, std::get<msgs::MotorCommand>(e.payload).velocity.v_m_s);
     }
     return v;
   };
@@ -45,10 +44,10 @@ TEST(MissionFollow, DrivesThePathAGuiSendsAndStandsStillBefore) {
   bool waiting = false;
   for (const Event& e : bus.events)
     waiting = waiting || (e.kind == EventKind::kMissionStatus &&
-                          std::get<mission::MissionStatus>(e.payload).state == mission::MissionState::kWaiting);
+                          std::get<msgs::MissionStatus>(e.payload).state == msgs::MissionState::kWaiting);
   EXPECT_TRUE(waiting);
   bus.events.clear();
-  mission->OnEvent(Event{t, t, "CONTROLLER_PATH", EventKind::kPath, drivers::Path{{{1.0, 0.0, 0.0}}}});
+  mission->OnEvent(Event{t, t, "CONTROLLER_PATH", EventKind::kPath, msgs::Path{{{1.0, 0.0, 0.0}}}});
   odometry(0.5);
   EXPECT_GT(max_speed(), 0.05);
   for (const Event& e : bus.events) EXPECT_NE(e.kind, EventKind::kPath) << "the GUI's path was published back";

@@ -1,5 +1,5 @@
 #include "competition.hpp"
-#include "pipeline.hpp"
+#include "mbot/pipeline/pipeline.hpp"
 #include "sweep_mode.hpp"
 
 #include <gtest/gtest.h>
@@ -13,7 +13,7 @@ namespace {
 
 std::string ErrorOf(const std::string& ini) {
   try {
-    BuildPlan(config::Config::FromString(ini, "t.ini"));
+    pipeline::BuildPlan(config::Config::FromString(ini, "t.ini"));
   } catch (const config::ConfigError& e) {
     return e.what();
   }
@@ -23,7 +23,7 @@ std::string ErrorOf(const std::string& ini) {
 constexpr const char* kBase = "[pipeline]\nstages = s\n[source]\npath = x.log\n";
 
 TEST(PipelineTest, BuildsRegisteredStages) {
-  auto plan = BuildPlan(config::Config::FromString(std::string(kBase) + "[s]\ntype = inspect\n", "t.ini"));
+  auto plan = pipeline::BuildPlan(config::Config::FromString(std::string(kBase) + "[s]\ntype = inspect\n", "t.ini"));
   ASSERT_EQ(plan.stages.size(), 1u);
   EXPECT_EQ(plan.stages[0].first, "s");
   EXPECT_EQ(plan.source.path, "x.log");
@@ -37,9 +37,24 @@ TEST(PipelineTest, UnknownStageTypeListsTheKnownOnes) {
              "inspect, lcm_bridge, map_writer, maze_generator, merge_sweep, mission, motor_calibration, "
              "movingai_benchmark, "
              "odometry, "
-             "recorder, referee, slam, tag_detection, tag_sightings, trajectory_writer)"),
+             "referee, slam, tag_detection, tag_sightings, trajectory_writer)"),
       std::string::npos)
       << e;
+}
+
+// A key nothing would read is an error: a path for type = none, the channel roles for a type whose
+// messages do not take their meaning from the channel.
+TEST(PipelineTest, AKeyNothingReadsIsAnError) {
+  EXPECT_NE(ErrorOf("[pipeline]\nstages = s\n[source]\ntype = none\npath = my_views/\n[s]\ntype = inspect\n")
+                .find("[source] path: type = none reads no input"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf("[pipeline]\nstages = s\n[source]\ntype = carmen\npath = x.log\nodometry_channels = A\n[s]\n"
+                    "type = inspect\n")
+                .find("[source] odometry_channels: unknown key"),
+            std::string::npos);
+  EXPECT_EQ(ErrorOf("[pipeline]\nstages = s\n[source]\ntype = lcm_log\npath = x.log\nodometry_channels = A\n[s]\n"
+                    "type = inspect\n"),
+            "");
 }
 
 TEST(PipelineTest, StrictErrors) {
@@ -63,18 +78,18 @@ TEST(PipelineTest, AnEmptyInputFailsTheRun) {
   auto c = config::Config::FromString(
       std::string("[pipeline]\nstages = s\nprogress = off\n[source]\ntype = carmen\npath = ") + empty +
       "\n[output]\ndir = " + ::testing::TempDir() + "/empty_out\n[s]\ntype = inspect\n");
-  PipelinePlan plan = BuildPlan(c);
+  pipeline::PipelinePlan plan = pipeline::BuildPlan(c);
   const std::atomic<bool> stop{false};
   try {
-    RunPlan(plan, stop);
+    pipeline::RunPlan(plan, stop);
     ADD_FAILURE();
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find(empty + ": no usable event"), std::string::npos) << e.what();
   }
   c.Set("source.type=lcm_log");
   c.Set("source.path=" + ::testing::TempDir());
-  PipelinePlan dir_plan = BuildPlan(c);
-  EXPECT_THROW(RunPlan(dir_plan, stop), std::runtime_error);
+  pipeline::PipelinePlan dir_plan = pipeline::BuildPlan(c);
+  EXPECT_THROW(pipeline::RunPlan(dir_plan, stop), std::runtime_error);
 }
 
 // Every shipped configuration parses strictly (keys, sections, stage types, values; a sweep's every
@@ -103,7 +118,7 @@ TEST(PipelineTest, EveryShippedConfigIsValid) {
     if (IsCompetition(c)) {
       EXPECT_NO_THROW(BuildCompetition(c));
     } else {
-      EXPECT_NO_THROW(BuildPlan(c));
+      EXPECT_NO_THROW(pipeline::BuildPlan(c));
     }
     ++n;
   }

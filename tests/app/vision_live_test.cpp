@@ -1,5 +1,5 @@
 // config/vision_live.ini end to end on rendered frames: camera source (an image folder) → tag
-// sightings → the recorder and the LCM bridge (in-process memq://). What went out on
+// sightings → the LCM bridge, and an lcm_log output (in-process memq://). What went out on
 // MBOT_APRILTAG_ARRAY, read back from the recorded log, holds every tag at its true place.
 #include <gtest/gtest.h>
 
@@ -55,16 +55,16 @@ TEST(VisionLiveConfig, PublishesEveryTagWhereItIsAsTheBotlabsArray) {
   EXPECT_EQ(Get(json, {"frames"}), 4);
   EXPECT_EQ(Get(json, {"sightings"}), 4);
 
-  drivers::SourceOptions o;
+  msgs::SourceOptions o;
   o.path = ::testing::TempDir() + "/vision_live/sightings.log";
-  auto log = drivers::OpenSource(o);
+  auto log = msgs::OpenSource(o);
   size_t k = 0;
   while (auto ev = log->Next()) {
     ASSERT_EQ(ev->channel, "MBOT_APRILTAG_ARRAY");
-    ASSERT_EQ(ev->kind, drivers::EventKind::kTagSightings);
+    ASSERT_EQ(ev->kind, msgs::EventKind::kTagSightings);
     ASSERT_LT(k, frames.size());
     EXPECT_EQ(ev->stamp_us, static_cast<int64_t>(std::llround(k * 1e6 / 15.0)));  // camera_fps = 15
-    const auto& got = std::get<drivers::TagSightings>(ev->payload).tags;
+    const auto& got = std::get<msgs::TagSightings>(ev->payload).tags;
     ASSERT_EQ(got.size(), frames[k].size()) << "frame " << k;
     for (const Truth& truth : frames[k]) {
       const auto it = std::find_if(got.begin(), got.end(), [&](const auto& s) { return s.id == truth.id; });

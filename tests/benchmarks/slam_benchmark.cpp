@@ -41,6 +41,7 @@
 #include "mbot/common/config.hpp"
 #include "mbot/drivers/map_io.hpp"
 #include "mbot/drivers/source_options.hpp"
+#include "mbot/lcm/lcm_sources.hpp"
 #include "mbot/mapping/action_model.hpp"
 #include "mbot/mapping/log_odds_mapper.hpp"
 #include "mbot/mapping/moving_scan.hpp"
@@ -50,6 +51,7 @@
 namespace {
 
 namespace drivers = mbot::drivers;
+namespace msgs = mbot::msgs;
 namespace mapping = mbot::mapping;
 using mbot::motion::Pose2D;
 
@@ -72,7 +74,7 @@ struct EvenScan {
 struct LogData {
   std::string error;  // non-empty: the data could not be read
   mapping::OccupancyGrid map;
-  std::vector<drivers::LidarScan> scans;
+  std::vector<msgs::LidarScan> scans;
   std::vector<Pose2D> odometry;
   std::vector<EvenScan> even_scans;
   size_t beams_max = 0;
@@ -81,7 +83,7 @@ struct LogData {
 // MRPT places beam i of n at -aperture/2 + i·aperture/(n-1). With aperture = 2π(n-1)/n the beams are
 // 2π/n apart and cover the full circle exactly once (aperture 2π would put two beams at ±π). Each of
 // our beams goes to the nearest of those angles; if two land on one, the shorter range wins.
-EvenScan ToEvenScan(const drivers::LidarScan& scan) {
+EvenScan ToEvenScan(const msgs::LidarScan& scan) {
   const size_t n = scan.ranges_m.size();
   EvenScan out;
   out.ranges.assign(n, 0.0f);
@@ -111,15 +113,15 @@ LogData Load() {
     const std::string dir = mbot::config::DatasetsDir();
     d.map = drivers::ReadBotlabMap(dir + "/" + kMap);
 
-    drivers::SourceOptions options;
+    msgs::SourceOptions options;
     options.path = dir + "/" + kLog;
-    auto source = drivers::OpenSource(options);
-    std::vector<std::pair<int64_t, drivers::LidarScan>> scans;
+    auto source = msgs::OpenSource(options);
+    std::vector<std::pair<int64_t, msgs::LidarScan>> scans;
     std::vector<mbot::motion::TimedPose> odometry;
     while (auto event = source->Next()) {
-      if (event->kind == drivers::EventKind::kLidar) {
-        if (auto* scan = std::get_if<drivers::LidarScan>(&event->payload)) scans.emplace_back(event->t_us, *scan);
-      } else if (event->kind == drivers::EventKind::kOdometry) {
+      if (event->kind == msgs::EventKind::kLidar) {
+        if (auto* scan = std::get_if<msgs::LidarScan>(&event->payload)) scans.emplace_back(event->t_us, *scan);
+      } else if (event->kind == msgs::EventKind::kOdometry) {
         if (auto* pose = std::get_if<Pose2D>(&event->payload)) odometry.push_back({event->t_us, *pose});
       }
     }
@@ -176,7 +178,7 @@ class ScanCycle {
   size_t next_ = 1;
 };
 
-std::vector<mapping::ScanRay> Rays(const drivers::LidarScan& scan) {
+std::vector<mapping::ScanRay> Rays(const msgs::LidarScan& scan) {
   return mapping::DeskewScan(scan.ranges_m, scan.angles_rad, {}, Pose2D{}, Pose2D{}, scan.max_range_m,
                              mapping::ScanOptions{});
 }
@@ -494,6 +496,8 @@ class RatioReporter : public benchmark::ConsoleReporter {
 }  // namespace
 
 int main(int argc, char** argv) {
+  mbot::drivers::RegisterDatasetSources();
+  mbot::lcmio::RegisterLcmTransport();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   RatioReporter reporter;

@@ -11,6 +11,8 @@
 #include "test_util.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 namespace {
 
 TEST(CameraSourceTest, ReplaysAFolderInNameOrderAndSkipsWhatItCannotRead) {
@@ -26,7 +28,9 @@ TEST(CameraSourceTest, ReplaysAFolderInNameOrderAndSkipsWhatItCannotRead) {
   SourceOptions o;
   o.type = "camera";
   o.path = dir;
-  o.camera.fps = 10.0;
+  CameraSourceOptions camera;
+  camera.fps = 10.0;
+  o.extra = camera;
   auto src = OpenSource(o);
   std::vector<Event> frames;
   while (auto ev = src->Next()) frames.push_back(*ev);

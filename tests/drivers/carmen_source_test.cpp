@@ -8,6 +8,8 @@
 #include "test_util.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 namespace {
 
 TEST(CarmenSourceTest, BeamGeometryFollowsCarmen) {
@@ -42,9 +44,9 @@ TEST(CarmenSourceTest, ParsesOldAndNewLinesKeepingPoseAndOdometryApart) {
   EXPECT_EQ(scan.ranges_m.size(), 3u);
   EXPECT_FLOAT_EQ(scan.max_range_m, 50.0f);  // from PARAM robot_front_laser_max
   EXPECT_EQ(ev[2].kind, EventKind::kReferencePose);
-  EXPECT_NEAR(std::get<motion::Pose2D>(ev[2].payload).x, 0.1, 1e-12);
+  EXPECT_NEAR(std::get<msgs::Pose2D>(ev[2].payload).x, 0.1, 1e-12);
   EXPECT_EQ(ev[3].kind, EventKind::kOdometry);
-  EXPECT_NEAR(std::get<motion::Pose2D>(ev[3].payload).x, 0.4, 1e-12);
+  EXPECT_NEAR(std::get<msgs::Pose2D>(ev[3].payload).x, 0.4, 1e-12);
   EXPECT_EQ(ev[5].channel, "ROBOTLASER1");
   const auto& rl = std::get<LidarScan>(ev[5].payload);
   EXPECT_NEAR(rl.angles_rad[2] - rl.angles_rad[1], 1.5708, 1e-5);

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "mbot/drivers/lcm_log.hpp"
-#include "mbot/drivers/source_options.hpp"
+#include "mbot/lcm/lcm_log.hpp"
+#include "mbot/lcm/lcm_sources.hpp"
 #include "mbot_lcm_msgs/mbot_encoders_t.hpp"
 #include "mbot_lcm_msgs/twist2D_t.hpp"
 #include "mbot_legacy/lidar_t.hpp"
@@ -11,7 +11,9 @@
 #include "mbot_legacy/pose_xyt_t.hpp"
 #include "test_util.hpp"
 
-namespace mbot::drivers {
+namespace mbot::lcmio {
+
+using namespace msgs;  // the event vocabulary
 namespace {
 
 mbot_legacy::lidar_t Scan(int n) {
@@ -135,8 +137,8 @@ TEST(LcmLogSourceTest, GroundTruthPoseIsRezeroed) {
   test::WriteBytes(path, b);
   const auto ev = ReadAll(path);
   ASSERT_EQ(ev.size(), 2u);
-  const auto p0 = std::get<motion::Pose2D>(ev[0].payload);
-  const auto p1 = std::get<motion::Pose2D>(ev[1].payload);
+  const auto p0 = std::get<msgs::Pose2D>(ev[0].payload);
+  const auto p1 = std::get<msgs::Pose2D>(ev[1].payload);
   EXPECT_NEAR(p0.x, 0, 1e-6);
   EXPECT_NEAR(p0.theta, 0, 1e-6);
   EXPECT_NEAR(p1.x, 1, 1e-6);  // moved +y in the world = forward for a robot facing +y
@@ -198,4 +200,4 @@ TEST(LcmLogSourceTest, RandomCorruptionNeverCrashes) {
 }
 
 }  // namespace
-}  // namespace mbot::drivers
+}  // namespace mbot::lcmio

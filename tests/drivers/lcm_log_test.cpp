@@ -1,10 +1,11 @@
-#include "mbot/drivers/lcm_log.hpp"
+#include "mbot/lcm/lcm_log.hpp"
 
 #include <gtest/gtest.h>
 
 #include "test_util.hpp"
 
-namespace mbot::drivers {
+namespace mbot::lcmio {
+
 namespace {
 
 TEST(LcmLogReaderTest, ReadsRecordsInOrder) {
@@ -109,4 +110,4 @@ TEST(LcmLogWriterTest, RoundTripsThroughTheReader) {
 }
 
 }  // namespace
-}  // namespace mbot::drivers
+}  // namespace mbot::lcmio

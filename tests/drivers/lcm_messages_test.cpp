@@ -16,7 +16,9 @@
 #include "mbot_w23/mbot_wheel_ctrl_t.hpp"
 #include "mbot_w23/occupancy_grid_t.hpp"
 
-namespace mbot::drivers {
+namespace mbot::lcmio {
+
+using namespace msgs;  // the event vocabulary
 namespace {
 
 Event RoundTrip(const Event& in) {
@@ -133,7 +135,7 @@ TEST(LcmMessages, PwmAndMeasuredWheelSpeedsAreDistinctTypes) {
 // exploration_status_t has five states: the mission's own in-progress states (driving, lifting …)
 // go out as exploring; the rest keep their meaning.
 TEST(LcmMessages, MissionStatesGoOutAsTheBotlabExplorationStates) {
-  using mission::MissionState;
+  using msgs::MissionState;
   const std::pair<MissionState, MissionState> cases[] = {{MissionState::kInitializing, MissionState::kInitializing},
                                                          {MissionState::kExploring, MissionState::kExploring},
                                                          {MissionState::kReturningHome, MissionState::kReturningHome},
@@ -143,18 +145,18 @@ TEST(LcmMessages, MissionStatesGoOutAsTheBotlabExplorationStates) {
                                                          {MissionState::kLifting, MissionState::kExploring}};
   for (const auto& [sent, received] : cases) {
     const Event out =
-        RoundTrip(Event{0, 9, "EXPLORATION_STATUS", EventKind::kMissionStatus, mission::MissionStatus{sent, "x"}});
+        RoundTrip(Event{0, 9, "EXPLORATION_STATUS", EventKind::kMissionStatus, msgs::MissionStatus{sent, "x"}});
     ASSERT_EQ(out.kind, EventKind::kMissionStatus);
-    EXPECT_EQ(std::get<mission::MissionStatus>(out.payload).state, received) << mission::ToString(sent);
+    EXPECT_EQ(std::get<msgs::MissionStatus>(out.payload).state, received) << msgs::ToString(sent);
   }
 }
 
 TEST(LcmMessages, SlamStatusCarriesTheMode) {
   std::vector<uint8_t> bytes;
-  ASSERT_TRUE(lcm_adapter::Encode(
-      Event{0, 1, "SLAM_STATUS", EventKind::kSlamStatus,
-            mapping::SlamStatus{mapping::SlamState::kLocalized, mapping::SlamMode::kLocalization, 0.1}},
-      &bytes));
+  ASSERT_TRUE(
+      lcm_adapter::Encode(Event{0, 1, "SLAM_STATUS", EventKind::kSlamStatus,
+                                msgs::SlamStatus{msgs::SlamState::kLocalized, msgs::SlamMode::kLocalization, 0.1}},
+                          &bytes));
   const lcm_adapter::TypeInfo* type = lcm_adapter::LookUp(lcm_adapter::Fingerprint(bytes.data(), bytes.size()));
   ASSERT_NE(type, nullptr);
   EXPECT_EQ(type->type, "slam_status_t");
@@ -164,10 +166,10 @@ TEST(LcmMessages, SlamStatusCarriesTheMode) {
 // `length - 1` (signed overflow); 0 asked std::string for SIZE_MAX bytes. Both are rejected first.
 TEST(LcmMessages, StringLengthsAreCheckedBeforeLcmGenDecodes) {
   std::vector<uint8_t> bytes;
-  ASSERT_TRUE(lcm_adapter::Encode(
-      Event{0, 1, "SLAM_STATUS", EventKind::kSlamStatus,
-            mapping::SlamStatus{mapping::SlamState::kLocalized, mapping::SlamMode::kLocalization, 0.1}},
-      &bytes));
+  ASSERT_TRUE(
+      lcm_adapter::Encode(Event{0, 1, "SLAM_STATUS", EventKind::kSlamStatus,
+                                msgs::SlamStatus{msgs::SlamState::kLocalized, msgs::SlamMode::kLocalization, 0.1}},
+                          &bytes));
   ASSERT_GE(bytes.size(), 24u);
   for (const std::vector<uint8_t>& length : {std::vector<uint8_t>{0x80, 0, 0, 0}, std::vector<uint8_t>{0, 0, 0, 0},
                                              std::vector<uint8_t>{0x7f, 0xff, 0xff, 0xff}}) {
@@ -201,9 +203,9 @@ TEST(LcmMessages, Winter2023GridStringLengthIsChecked) {
 }
 
 TEST(LcmMessages, OdometryPoseRoundTrips) {
-  const Event out = RoundTrip(Event{0, 7, "MBOT_ODOMETRY", EventKind::kOdometry, motion::Pose2D{1.5, -2.0, 0.75}});
+  const Event out = RoundTrip(Event{0, 7, "MBOT_ODOMETRY", EventKind::kOdometry, msgs::Pose2D{1.5, -2.0, 0.75}});
   ASSERT_EQ(out.kind, EventKind::kOdometry);
-  const auto& p = std::get<motion::Pose2D>(out.payload);
+  const auto& p = std::get<msgs::Pose2D>(out.payload);
   EXPECT_FLOAT_EQ(p.x, 1.5f);
   EXPECT_FLOAT_EQ(p.y, -2.0f);
   EXPECT_FLOAT_EQ(p.theta, 0.75f);
@@ -250,7 +252,7 @@ TEST(LcmMessages, LegacyGenerationDecodes) {
   pose.utime = 13, pose.x = 1.5f, pose.y = 2.5f, pose.theta = 0.5f;
   const Event p = DecodeOld("TRUE_POSE", pose);
   ASSERT_EQ(p.kind, EventKind::kGroundTruth);
-  EXPECT_FLOAT_EQ(std::get<motion::Pose2D>(p.payload).y, 2.5f);
+  EXPECT_FLOAT_EQ(std::get<msgs::Pose2D>(p.payload).y, 2.5f);
 }
 
 TEST(LcmMessages, Winter2023AndMaebotGenerationsDecode) {
@@ -275,4 +277,4 @@ TEST(LcmMessages, Winter2023AndMaebotGenerationsDecode) {
 }
 
 }  // namespace
-}  // namespace mbot::drivers
+}  // namespace mbot::lcmio

@@ -20,10 +20,12 @@
 #include "test_util.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 namespace {
 
-mapping::OccupancyGrid Fixture() {
-  mapping::OccupancyGrid g(7, 5, 0.05, -1.25, 2.5);
+msgs::OccupancyGrid Fixture() {
+  msgs::OccupancyGrid g(7, 5, 0.05, -1.25, 2.5);
   int v = -127;
   for (auto& c : g.cells()) {
     c = static_cast<int8_t>(v);
@@ -241,7 +243,7 @@ TEST(MapIoTest, SimplemapScansWithCorruptRangesCannotGrowTheGridWithoutBound) {
   }
   const auto path = test::TempPath("far.simplemap");
   ASSERT_TRUE(sm.saveToFile(path));
-  const mapping::OccupancyGrid g = ReadMrptSimplemap(path);
+  const msgs::OccupancyGrid g = ReadMrptSimplemap(path);
   EXPECT_LE(static_cast<long long>(g.width()) * g.height(), kMaxMapCells);
   EXPECT_LT(g.width(), 1000);  // the sane scan's map, the far one left out
 }

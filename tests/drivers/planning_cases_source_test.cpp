@@ -10,6 +10,8 @@
 #include "test_util.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 namespace {
 
 void WriteText(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
@@ -17,7 +19,7 @@ void WriteText(const std::string& path, const std::string& text) { std::ofstream
 std::string BotlabFixture(const std::string& dir_name, const std::string& poses) {
   const std::string dir = test::TempPath(dir_name);
   std::filesystem::create_directories(dir);
-  WriteBotlabMap(mapping::OccupancyGrid(20, 10, 0.05, -0.5, -0.25, -100), dir + "/room.map");
+  WriteBotlabMap(msgs::OccupancyGrid(20, 10, 0.05, -0.5, -0.25, -100), dir + "/room.map");
   WriteText(dir + "/room_poses.txt", poses);
   return dir;
 }
@@ -65,7 +67,7 @@ TEST(PlanningCasesSourceTest, MovingAiScenariosFlipRowsAndFindTheirMap) {
   PlanningCasesSource src(scen, "movingai");
   auto map = src.Next();
   ASSERT_TRUE(map);
-  const auto& grid = *std::get<std::shared_ptr<const mapping::OccupancyGrid>>(map->payload);
+  const auto& grid = *std::get<std::shared_ptr<const msgs::OccupancyGrid>>(map->payload);
   EXPECT_GT(grid.at(1, 1), 0);                                       // the '@' row is the middle one either way
   const PlanRequest r = std::get<PlanRequest>(src.Next()->payload);  // a copy: the event is a temporary
   EXPECT_EQ(r.start.x, 0.5);

@@ -17,6 +17,8 @@
 #include "test_util.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 namespace {
 
 TEST(RawlogSourceTest, ObservationsOnlyFormatIsReadInTimeOrder) {
@@ -55,7 +57,7 @@ TEST(RawlogSourceTest, ObservationsOnlyFormatIsReadInTimeOrder) {
   ASSERT_TRUE(b);
   EXPECT_EQ(b->kind, EventKind::kOdometry);
   EXPECT_EQ(b->t_us - a->t_us, 500000);
-  EXPECT_NEAR(std::get<motion::Pose2D>(b->payload).y, 2.0, 1e-9);
+  EXPECT_NEAR(std::get<msgs::Pose2D>(b->payload).y, 2.0, 1e-9);
   EXPECT_FALSE(src->Next());
 }
 

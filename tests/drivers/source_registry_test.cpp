@@ -11,6 +11,8 @@
 #include "test_util.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 namespace {
 
 // A source of `count` odometry events, registered as type "test_counter" for `.counter` files.
@@ -20,7 +22,7 @@ class CounterSource : public Source {
   std::optional<Event> Next() override {
     if (i_ >= count_) return std::nullopt;
     ++i_;
-    return Event{i_ * 1000, i_ * 1000, "ODOMETRY", EventKind::kOdometry, motion::Pose2D{double(i_), 0, 0}};
+    return Event{i_ * 1000, i_ * 1000, "ODOMETRY", EventKind::kOdometry, msgs::Pose2D{double(i_), 0, 0}};
   }
   double Progress() const override { return count_ ? double(i_) / count_ : 1.0; }
   std::string Format() const override { return "counter"; }

@@ -16,11 +16,16 @@
 #include <vector>
 
 #include "lcm_messages.hpp"
-#include "mbot/drivers/lcm_log.hpp"
+#include "mbot/lcm/lcm_log.hpp"
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/drivers/map_io.hpp"
 #include "mbot/drivers/source_options.hpp"
+#include "mbot/lcm/lcm_sources.hpp"
+
+namespace mbot::mapping {
+void RegisterScanRenderer();  // libs/mapping: scan_renderer.cpp
+}
 
 namespace {
 
@@ -46,10 +51,10 @@ std::string Write(const std::string& name, const uint8_t* data, size_t size) {
 
 // Opens `path` as a source of `type` and reads every event.
 void Drain(const std::string& path, const std::string& type) {
-  mbot::drivers::SourceOptions o;
+  mbot::msgs::SourceOptions o;
   o.path = path;
   o.type = type;
-  auto src = mbot::drivers::OpenSource(o);
+  auto src = mbot::msgs::OpenSource(o);
   while (src->Next()) {
   }
 }
@@ -66,10 +71,10 @@ constexpr size_t kChannelCount = sizeof kChannels / sizeof *kChannels;
 [[maybe_unused]] void LcmMessages(const uint8_t* d, size_t n) {
   if (n == 0) return;
   const std::string channel = kChannels[d[0] % kChannelCount];
-  const mbot::drivers::ChannelRoles roles;
-  mbot::drivers::Event event;
+  const mbot::msgs::ChannelRoles roles;
+  mbot::msgs::Event event;
   std::string error;
-  mbot::drivers::lcm_adapter::Decode(channel, d + 1, n - 1, roles, &event, &error);
+  mbot::lcmio::lcm_adapter::Decode(channel, d + 1, n - 1, roles, &event, &error);
 }
 
 [[maybe_unused]] void Rawlog(const uint8_t* d, size_t n) { Drain(Write("in.rawlog", d, n), "rawlog"); }
@@ -131,7 +136,7 @@ void CarveLcmMessages() {
     start = end + 1;
     if (log.empty()) continue;
     try {
-      mbot::drivers::LcmLogReader reader(log);
+      mbot::lcmio::LcmLogReader reader(log);
       std::map<std::string, int> per_channel;
       while (auto r = reader.Next()) {
         if (++per_channel[r->channel] > 3) continue;
@@ -154,6 +159,9 @@ void CarveLcmMessages() {
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
+  mbot::mapping::RegisterScanRenderer();  // simplemaps are rendered by libs/mapping
+  mbot::drivers::RegisterDatasetSources();
+  mbot::lcmio::RegisterLcmTransport();
   CarveLcmMessages();
   return 0;
 }

@@ -50,8 +50,9 @@ score="$out/robot/score.json"
 fail=0
 grep -q '"completed": true' "$score" || { echo "FAIL: the referee did not see the mission complete"; fail=1; }
 grep -q '"collisions": 0,' "$score" || { echo "FAIL: the robot hit something"; fail=1; }
-grep -q "\"total\": $((100 * crates)), \"max\": $((100 * crates))" "$score" ||
-  { echo "FAIL: not every crate lifted and stacked: $(grep '"total"' "$score")"; fail=1; }
+points=$(python3 -c 'import json, sys; p = json.load(open(sys.argv[1]))["points"]; print(p["total"], p["max"])' "$score")
+[ "$points" = "$((100 * crates)) $((100 * crates))" ] ||
+  { echo "FAIL: not every crate lifted and stacked: points (total, max) $points"; fail=1; }
 grep -q '"state": "completed"' "$out/autonomy/mission.json" || { echo "FAIL: the autonomy's mission did not complete"; fail=1; }
 for p in autonomy vision; do
   grep -E "^lcm: [0-9.]+ messages/s" "$out/$p.log" | tail -1 | grep -q " 0 rejected" ||

@@ -8,13 +8,15 @@
 #include <iostream>
 #include <thread>
 
-#include "mbot/drivers/lcm_live.hpp"
+#include "mbot/lcm/lcm_live.hpp"
 #include "mbot/drivers/map_io.hpp"
-#include "mbot/drivers/sink.hpp"
-#include "mbot/drivers/source.hpp"
-#include "mbot/drivers/source_options.hpp"
+#include "mbot/msgs/sink.hpp"
+#include "mbot/msgs/source.hpp"
+#include "mbot/lcm/lcm_sources.hpp"
 
-namespace mbot::drivers {
+namespace mbot::lcmio {
+
+using namespace msgs;  // the event vocabulary
 namespace {
 
 // A port of its own per test binary run; ttl=0 keeps it on the machine (the namespace's loopback).
@@ -38,8 +40,10 @@ SourceOptions LiveOptions() {
   SourceOptions o;
   o.type = "lcm_live";
   o.path = kUrl;
-  o.live.stale_sensor_s = 0.3;
-  o.live.report_every_s = 0;
+  LiveSourceOptions live;
+  live.stale_sensor_s = 0.3;
+  live.report_every_s = 0;
+  o.extra = live;
   return o;
 }
 
@@ -54,11 +58,11 @@ TEST(LcmLive, MalformedPacketsOnEverySubscribedChannelAreRejectedAndCountedAndTh
   scan.angles_rad = {0.0f, 0.1f, 0.2f};
   const std::vector<uint8_t> lidar = EncodeEvent(Event{0, 5, "LIDAR", EventKind::kLidar, scan});
   const std::vector<uint8_t> pose =
-      EncodeEvent(Event{0, 5, "MBOT_ODOMETRY", EventKind::kOdometry, motion::Pose2D{1, 2, 0.5}});
+      EncodeEvent(Event{0, 5, "MBOT_ODOMETRY", EventKind::kOdometry, msgs::Pose2D{1, 2, 0.5}});
   ASSERT_FALSE(lidar.empty());
   ASSERT_EQ(pose.size(), 8u + 8 + 12);
   int bad = 0;
-  for (const std::string& channel : o.live.channels) {
+  for (const std::string& channel : ExtraOr<LiveSourceOptions>(o).channels) {
     std::vector<uint8_t> truncated(lidar.begin(), lidar.begin() + lidar.size() / 2);
     std::vector<uint8_t> wrong_fingerprint = pose;
     wrong_fingerprint[0] ^= 0x5a;
@@ -75,14 +79,14 @@ TEST(LcmLive, MalformedPacketsOnEverySubscribedChannelAreRejectedAndCountedAndTh
   nan_pose[16] = 0x7f, nan_pose[17] = 0xc0, nan_pose[18] = 0, nan_pose[19] = 0;
   robot.PublishRaw("MBOT_ODOMETRY", nan_pose);
   robot.PublishRaw("MBOT_ODOMETRY",
-                   EncodeEvent(Event{0, -5, "MBOT_ODOMETRY", EventKind::kOdometry, motion::Pose2D{1, 2, 0.5}}));
+                   EncodeEvent(Event{0, -5, "MBOT_ODOMETRY", EventKind::kOdometry, msgs::Pose2D{1, 2, 0.5}}));
   bad += 3;                                 // and a negative utime
   robot.PublishRaw("MBOT_ODOMETRY", pose);  // and one good message: it still passes
   const std::vector<Event> got = Drain(*source, 0.5);
   EXPECT_EQ(source->diagnostics().rejected_messages, bad);
   ASSERT_EQ(got.size(), 1u);
   EXPECT_EQ(got[0].kind, EventKind::kOdometry);
-  EXPECT_EQ(std::get<motion::Pose2D>(got[0].payload).x, 1.0);
+  EXPECT_EQ(std::get<msgs::Pose2D>(got[0].payload).x, 1.0);
   bool named = false;
   for (const auto& [k, v] : source->Details()) named = named || k == "rejected on LIDAR";
   EXPECT_TRUE(named);
@@ -119,7 +123,7 @@ TEST(LcmLive, ASilentSensorStopsTheRobotAndHoldsCommandsBack) {
   scan.ranges_m = {1.0f};
   scan.angles_rad = {0.0f};
   robot.Publish(Event{0, 5, "LIDAR", EventKind::kLidar, scan});
-  robot.Publish(Event{0, 5, "MBOT_ODOMETRY", EventKind::kOdometry, motion::Pose2D{}});
+  robot.Publish(Event{0, 5, "MBOT_ODOMETRY", EventKind::kOdometry, msgs::Pose2D{}});
   Drain(*source, 0.2);
   sink->Send(Event{0, 0, "MBOT_VEL_CMD", EventKind::kMotorCommand, MotorCommand::Velocity(0.3, 0.5)});
   cmds.clear();
@@ -140,7 +144,7 @@ TEST(LiveReplay, TheRecordedRunReplaysToTheLiveMap) {
   const char* live_path = std::getenv("MBOT_LIVE_MAP");
   const char* replay_path = std::getenv("MBOT_REPLAY_MAP");
   ASSERT_TRUE(live_path && replay_path) << "run by tests/live/explore_over_lcm.sh (MBOT_LIVE_MAP, MBOT_REPLAY_MAP)";
-  const mapping::OccupancyGrid live = ReadBotlabMap(live_path), replay = ReadBotlabMap(replay_path);
+  const msgs::OccupancyGrid live = drivers::ReadBotlabMap(live_path), replay = drivers::ReadBotlabMap(replay_path);
   ASSERT_EQ(live.width(), replay.width());
   ASSERT_EQ(live.height(), replay.height());
   auto cls = [](int v) { return v > 0 ? 1 : v < 0 ? -1 : 0; };
@@ -159,4 +163,4 @@ TEST(LiveReplay, TheRecordedRunReplaysToTheLiveMap) {
 }
 
 }  // namespace
-}  // namespace mbot::drivers
+}  // namespace mbot::lcmio

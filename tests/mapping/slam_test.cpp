@@ -89,6 +89,45 @@ TEST(Slam, ActionOnlyFollowsOdometry) {
   EXPECT_NEAR(end.y, -0.5, 0.05);
 }
 
+// A person's switches (the viewer): mapping off keeps the map; localization off follows odometry
+// (here drifting 0.3 degrees a step, uncorrected); clearing forgets every cell; and what a mode
+// cannot do is refused, saying why.
+TEST(Slam, MappingAndLocalizationCanBeSwitchedAndTheMapCleared) {
+  const Room room;
+  Slam slam(Options(SlamMode::kFullSlam), 3);
+  slam.Initialize({-0.5, -0.5, 0}, {-0.5, -0.5, 0});
+  slam.ProcessScan(MarchScan(room.map, {-0.5, -0.5, 0}), {-0.5, -0.5, 0});
+  const OccupancyGrid first = slam.map();
+  slam.SetMapping(false);
+  slam.SetLocalization(false);
+  SlamStep step;
+  Pose2D odometry{-0.5, -0.5, 0};
+  for (int i = 1; i <= 20; ++i) {
+    odometry = odometry.Compose(Pose2D{0.05, 0.0, 0.3 * M_PI / 180});
+    step = slam.ProcessScan(MarchScan(room.map, {-0.5 + 0.05 * i, -0.5, 0.0}), odometry);
+  }
+  EXPECT_EQ(slam.map(), first) << "mapping off: the map must stay as it was";
+  // The pose is odometry's from the first scan's estimate on (the filter's first update may have
+  // moved that by a little): 6 degrees of drift stay, where localization corrects them to 1.5.
+  EXPECT_NEAR(step.pose.theta, odometry.theta, 0.5 * M_PI / 180) << "localization off: the pose is odometry's";
+  EXPECT_NEAR(step.pose.x, odometry.x, 0.02);
+  slam.SetMapping(true);
+  slam.ProcessScan(MarchScan(room.map, {0.5, -0.5, 0}), odometry);
+  EXPECT_FALSE(slam.map() == first) << "mapping on again: the scan went into the map";
+  slam.ClearMap();
+  int known = 0;
+  for (int8_t c : slam.map().cells()) known += c != 0;
+  EXPECT_EQ(known, 0);
+  EXPECT_EQ(slam.map().width(), first.width());
+
+  Slam localization(Options(SlamMode::kLocalization), 1);
+  localization.SetMap(room.map);
+  EXPECT_THROW(localization.SetMapping(true), std::invalid_argument);
+  EXPECT_THROW(localization.ClearMap(), std::invalid_argument);
+  Slam mapping_only(Options(SlamMode::kMappingOnly), 1);
+  EXPECT_THROW(mapping_only.SetLocalization(false), std::invalid_argument);
+}
+
 TEST(Slam, StatusNamesWhatThePoseIsWorth) {
   FilterStatus s;
   EXPECT_EQ(StateOf(SlamMode::kFullSlam, s), SlamState::kMapping);

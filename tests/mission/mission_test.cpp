@@ -45,6 +45,7 @@ struct KinematicRun {
   std::vector<MissionStatus> statuses;
   std::vector<std::vector<Pose2D>> paths;
   std::vector<motion::VelocityCommand> commands;
+  std::vector<ExplorationOut> seen;  // explore: what the explorer saw at each step
   std::function<std::shared_ptr<const mapping::OccupancyGrid>(const Pose2D&)> reveal;
 
   // Runs until the mission completes or fails, or `seconds` pass; returns the final state.
@@ -58,6 +59,7 @@ struct KinematicRun {
       for (const MissionOutput& out : mission.OnOdometry(t_us, truth)) {
         if (const auto* s = std::get_if<MissionStatus>(&out)) statuses.push_back(*s);
         if (const auto* p = std::get_if<PathOut>(&out)) paths.push_back(p->poses);
+        if (const auto* x = std::get_if<ExplorationOut>(&out)) seen.push_back(*x);
         if (const auto* c = std::get_if<motion::VelocityCommand>(&out)) {
           commands.push_back(*c);
           if (!stuck) truth = motion::StepUnicycle(truth, *c, 0.02);
@@ -102,6 +104,7 @@ TEST(MissionExplore, ExploresTheRoomAndReturnsHome) {
   auto known = std::make_shared<mapping::OccupancyGrid>(truth);
   std::fill(known->cells().begin(), known->cells().end(), 0);
   Mission m(Parse("task = explore\nrobot_radius_m = 0.1\n"), 1);
+  m.set_watched(true);
   KinematicRun run(m, {0, 0, 0});
   run.reveal = [&](const Pose2D& p) {
     for (int y = 0; y < truth.height(); ++y) {
@@ -122,6 +125,18 @@ TEST(MissionExplore, ExploresTheRoomAndReturnsHome) {
     for (int x = 1; x + 1 < truth.width(); ++x) unknown_inside += known->at(x, y) == 0;
   }
   EXPECT_EQ(unknown_inside, 0) << "the robot came home before it had seen the whole room";
+  // For a viewer: the explorer's frontiers (there were some at the start, none at the end) and its
+  // distances, on the map's grid, 0 at the walls.
+  ASSERT_GT(run.seen.size(), 10u);
+  EXPECT_FALSE(run.seen.front().frontiers.regions.empty());
+  EXPECT_FALSE(run.seen.front().frontiers.regions.front().cells.empty());
+  EXPECT_TRUE(run.seen.back().frontiers.regions.empty());
+  ASSERT_TRUE(run.seen.back().distances);
+  const msgs::DistanceGrid& d = *run.seen.back().distances;
+  EXPECT_EQ(d.width, truth.width());
+  EXPECT_EQ(d.height, truth.height());
+  EXPECT_EQ(d.distance_m[0], 0.0f);                                    // a wall cell
+  EXPECT_NEAR(d.distance_m[size_t(20) * d.width + 40], 0.95f, 0.05f);  // the room's middle row: 19 cells to the wall
   if (unknown_inside) {
     for (int y = truth.height() - 1; y >= 0; y -= 2) {
       std::string row;
@@ -178,6 +193,33 @@ TEST(MissionFollow, DrivesEachPathItIsSentAndDoesNotPublishItBack) {
   EXPECT_NEAR(run.truth.x, 0.5, 0.03);
   EXPECT_NEAR(run.truth.y, 0.5, 0.03);
   EXPECT_TRUE(run.paths.empty());
+}
+
+// A person at the viewer: a goal is planned with A* on the map and driven to; teleop drives only
+// while its commands keep coming (the dead man: teleop_timeout_s), clamped to the controller's
+// limits; either takes over from the task.
+TEST(MissionPerson, DrivesToAPersonsGoalThenObeysTeleopUntilItStops) {
+  auto room = std::make_shared<const mapping::OccupancyGrid>(Room(-1, -1, 3, 3));
+  Mission m(Parse("task = explore\nstart_delay_s = 0\nrobot_radius_m = 0.1\n"), 1);
+  KinematicRun run(m, {0, 0, 0});
+  run.reveal = [&](const Pose2D&) { return room; };
+  run.Run(0.5);
+  m.OnGoal({1.0, 0.8, 0});
+  run.Run(30);
+  EXPECT_TRUE(m.manual());
+  EXPECT_EQ(m.status().state, MissionState::kArrived) << m.status().detail;
+  EXPECT_NEAR(run.truth.x, 1.0, 0.03);
+  EXPECT_NEAR(run.truth.y, 0.8, 0.03);
+  // Teleop at 5 m/s asks too much: clamped to the controller's 0.3 m/s; after its last command
+  // the robot stops within the dead man's 0.5 s.
+  run.commands.clear();
+  m.OnTeleop(run.t_us, 5.0, 0.0);
+  run.Run(0.3);
+  ASSERT_FALSE(run.commands.empty());
+  EXPECT_NEAR(run.commands.back().v_m_s, 0.3, 1e-9);
+  run.Run(0.4);  // 0.7 s after the only teleop command
+  EXPECT_EQ(run.commands.back().v_m_s, 0.0);
+  EXPECT_EQ(m.status().state, MissionState::kWaiting) << m.status().detail;
 }
 
 // Pushing against something: the robot backs off after stuck_s, and after max_stalls stalls on

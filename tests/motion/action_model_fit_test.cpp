@@ -151,3 +151,24 @@ TEST(ActionModelFitTest, FewWindowsAreFlagged) {
 
 }  // namespace
 }  // namespace mbot::motion
+
+namespace mbot::motion {
+namespace {
+
+// A burst: the third sample arrived 0.8 s late; on its stamp it goes back between its neighbours.
+TEST(PlaceOnStamps, LateSamplesGoToTheirStampsOnTheLogClock) {
+  std::vector<TimedPose> s = {
+      {1'000'000, {0, 0, 0}}, {1'100'000, {1, 0, 0}}, {2'000'000, {2, 0, 0}}, {1'300'000, {3, 0, 0}}};
+  const std::vector<int64_t> stamps = {500'000, 600'000, 700'000, 800'000};  // the robot's clock
+  EXPECT_NEAR(PlaceOnStamps(&s, stamps), 0.8, 1e-9);
+  ASSERT_EQ(s.size(), 4u);
+  EXPECT_EQ(s[0].t_us, 1'000'000);
+  EXPECT_EQ(s[2].t_us, 1'200'000);  // the late one, at its stamp + 0.5 s
+  EXPECT_EQ(s[2].pose.x, 2);
+  std::vector<TimedPose> unstamped = {{1, {}}, {2, {}}};
+  EXPECT_EQ(PlaceOnStamps(&unstamped, {0, 5}), -1);
+  EXPECT_EQ(unstamped[0].t_us, 1);
+}
+
+}  // namespace
+}  // namespace mbot::motion

@@ -12,11 +12,13 @@
 #include "mbot/common/log.hpp"
 #include "mbot/drivers/map_io.hpp"
 #include "mbot/drivers/source_options.hpp"
-#include "pipeline.hpp"
+#include "mbot/pipeline/pipeline.hpp"
 
 namespace fs = std::filesystem;
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 namespace {
 
 std::string Data(const std::string& rel) { return config::DatasetsDir() + "/" + rel; }
@@ -71,7 +73,7 @@ Summary Read(const std::string& path) {
         }
       }
       if (scan->angles_rad.size() > 2) {
-        c.spacing.push_back(std::abs(motion::WrapAngle(scan->angles_rad[2] - scan->angles_rad[1])));
+        c.spacing.push_back(std::abs(msgs::WrapAngle(scan->angles_rad[2] - scan->angles_rad[1])));
       }
     }
   }
@@ -147,11 +149,11 @@ TEST(BotlabLogs, DriveSquareGroundTruthTravelsAboutFourMetres) {
   o.path = Data("botlab/legacy_2017/sweep_drive_square_10mx10m_5cm.log");
   auto src = OpenSource(o);
   double path = 0;
-  motion::Pose2D last;
+  msgs::Pose2D last;
   bool first = true;
   while (auto ev = src->Next()) {
     if (ev->kind != EventKind::kGroundTruth) continue;
-    const auto p = std::get<motion::Pose2D>(ev->payload);
+    const auto p = std::get<msgs::Pose2D>(ev->payload);
     if (!first) path += std::hypot(p.x - last.x, p.y - last.y);
     last = p;
     first = false;
@@ -376,15 +378,15 @@ TEST(Maps, MrptGridmap) {
 // ---- the application end to end ---------------------------------------------------------------
 
 // Runs the shipped replay configuration into a fresh folder `out`; `stop` set = Ctrl-C at once.
-app::RunSummary RunReplay(const std::string& out, bool stop_at_once) {
+pipeline::RunSummary RunReplay(const std::string& out, bool stop_at_once) {
   auto c = config::Config::Load(std::string(MBOT_SOURCE_DIR) + "/config/replay.ini");
   fs::remove_all(out);
   c.Set("output.dir=" + out);
   c.Set("pipeline.progress=off");
   c.Set("inspect.print=false");
-  auto plan = app::BuildPlan(c);
+  auto plan = pipeline::BuildPlan(c);
   std::atomic<bool> stop{stop_at_once};
-  return app::RunPlan(plan, stop);
+  return pipeline::RunPlan(plan, stop);
 }
 
 TEST(App, InspectPipelineOnARealLogWritesItsSummary) {

@@ -7,9 +7,11 @@
 #include <iostream>
 
 #include "mbot/common/config.hpp"
+#include "stages/stages.hpp"
 
 int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
+  mbot::app::RegisterAll();
   const std::string dir = mbot::config::DatasetsDir();
   const bool listing = ::testing::GTEST_FLAG(list_tests);
   if (!listing && !std::filesystem::is_directory(dir + "/botlab")) {

@@ -8,7 +8,7 @@
 #include "../planning/exploration_sim.hpp"
 #include "mbot/common/config.hpp"
 #include "mbot/drivers/map_io.hpp"
-#include "pipeline.hpp"
+#include "mbot/pipeline/pipeline.hpp"
 
 namespace mbot::planning {
 namespace {
@@ -20,10 +20,10 @@ TEST(PlanningRegressionTest, BotlabAStarCasesAllPassThroughTheShippedConfig) {
   cfg.Set("output.dir=" + ::testing::TempDir() + "/astar_test");
   cfg.Set("astar.repeats=3");
   cfg.Set("pipeline.progress=off");
-  app::PipelinePlan plan = app::BuildPlan(cfg);
+  pipeline::PipelinePlan plan = pipeline::BuildPlan(cfg);
   std::atomic<bool> stop{false};
   ::testing::internal::CaptureStdout();
-  EXPECT_NO_THROW(app::RunPlan(plan, stop));  // throws when any map fails
+  EXPECT_NO_THROW(pipeline::RunPlan(plan, stop));  // throws when any map fails
   const std::string out = ::testing::internal::GetCapturedStdout();
   for (const char* map : {"convex", "empty", "filled", "maze", "narrow", "wide"}) {
     EXPECT_NE(out.find(std::string(map) + std::string(10 - std::string(map).size() + 1, ' ') + "PASSED"),

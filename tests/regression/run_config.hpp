@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "mbot/common/config.hpp"
-#include "pipeline.hpp"
+#include "mbot/pipeline/pipeline.hpp"
 
 namespace mbot::app {
 
@@ -27,9 +27,9 @@ inline std::string RunConfig(const std::string& config_name, const std::string& 
   c.Set("output.dir=" + out);
   c.Set("pipeline.progress=off");
   for (const auto& s : sets) c.Set(s);
-  auto plan = BuildPlan(c);
+  auto plan = pipeline::BuildPlan(c);
   std::atomic<bool> stop{false};
-  RunPlan(plan, stop);
+  pipeline::RunPlan(plan, stop);
   std::ifstream in(out + "/" + report);
   std::stringstream ss;
   ss << in.rdbuf();

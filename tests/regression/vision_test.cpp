@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <filesystem>
 #include <fstream>
 #include <opencv2/core.hpp>
 #include <sstream>
@@ -36,15 +37,34 @@ TEST(VisionRegression, CalibrationReproducesOpenCvsOwnResultWithin1Percent) {
   EXPECT_EQ(Get(json, {"used"}), 13);
 }
 
+// The views come through the source like every other input: `--set source.path=my_views/`
+// calibrates those views, not the shipped ones.
+TEST(VisionRegression, TheViewsAreTheSourcesPath) {
+  const std::string mine = ::testing::TempDir() + "/my_views";
+  std::filesystem::remove_all(mine);
+  std::filesystem::create_directories(mine);
+  for (const char* f :
+       {"left01.jpg", "left02.jpg", "left03.jpg", "left04.jpg", "left05.jpg", "left06.jpg", "left07.jpg"}) {
+    std::filesystem::copy_file(Data(std::string("camera/opencv_chessboard/") + f), mine + "/" + f);
+  }
+  const std::string json =
+      RunConfig("calibrate_camera.ini", "calibrate_my_views", {"source.path=" + mine}, "calibration.json");
+  ASSERT_FALSE(json.empty());
+  EXPECT_EQ(Get(json, {"views"}), 7);
+  EXPECT_NE(json.find("\"images\": \"" + mine + "\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"view\": \"left07.jpg\""), std::string::npos) << json;
+  EXPECT_EQ(json.find("left08.jpg"), std::string::npos) << json;
+}
+
 TEST(VisionRegression, TooStrictAcceptanceFailsTheRunSayingWhy) {
   auto c = config::Config::Load(std::string(MBOT_SOURCE_DIR) + "/config/calibrate_camera.ini");
   c.Set("output.dir=" + ::testing::TempDir() + "/calibrate_camera_strict");
   c.Set("calibration.max_error_px=0.1");
   c.Set("pipeline.progress=off");
-  auto plan = BuildPlan(c);
+  auto plan = pipeline::BuildPlan(c);
   std::atomic<bool> stop{false};
   try {
-    RunPlan(plan, stop);
+    pipeline::RunPlan(plan, stop);
     FAIL() << "a calibration above max_error_px was accepted";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("not accepted: mean reprojection error"), std::string::npos) << e.what();

@@ -213,17 +213,17 @@ TEST(Forklift, SimRobotPublishesStatusAndCrates) {
   EXPECT_EQ(robot.forklift_commands_clamped(), 1);
 
   int statuses = 0, crate_messages = 0;
-  const drivers::ForkliftStatus* last = nullptr;
-  const drivers::CrateStates* crates = nullptr;
+  const msgs::ForkliftStatus* last = nullptr;
+  const msgs::CrateStates* crates = nullptr;
   for (const Event& e : events) {
     if (e.kind == EventKind::kForkliftStatus) {
       ++statuses;
       EXPECT_EQ(e.channel, "MBOT_FORKLIFT_STATUS");
-      last = &std::get<drivers::ForkliftStatus>(e.payload);
+      last = &std::get<msgs::ForkliftStatus>(e.payload);
     } else if (e.kind == EventKind::kCrates) {
       ++crate_messages;
       EXPECT_EQ(e.channel, "SIM_CRATES");
-      crates = &std::get<drivers::CrateStates>(e.payload);
+      crates = &std::get<msgs::CrateStates>(e.payload);
     }
   }
   const double seconds = (t + 3'000'000) * 1e-6;

@@ -142,7 +142,7 @@ TEST(SimCamera, SimRobotPublishesFramesAtItsRate) {
   for (const Event& e : events) {
     if (e.kind != EventKind::kCameraFrame) continue;
     EXPECT_EQ(e.channel, "CAMERA");
-    const auto& f = std::get<drivers::CameraFrame>(e.payload);
+    const auto& f = std::get<msgs::CameraFrame>(e.payload);
     ASSERT_EQ(f.width, 640);
     ASSERT_EQ(f.height, 480);
     ASSERT_TRUE(f.pixels && f.pixels->size() == 640u * 480u);

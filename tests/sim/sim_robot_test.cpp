@@ -20,7 +20,7 @@
 namespace mbot::sim {
 namespace {
 
-using namespace mbot::drivers;  // the event and source types the simulator speaks
+using namespace mbot::msgs;  // the event and source types the simulator speaks
 
 using motion::Pose2D;
 

@@ -17,7 +17,8 @@
 namespace mbot::sim {
 namespace {
 
-using namespace mbot::drivers;  // the event and source types the simulator speaks
+using namespace mbot::drivers;  // map files
+using namespace mbot::msgs;     // the event and source types the simulator speaks
 
 constexpr double kPi = 3.14159265358979323846;
 

@@ -7,7 +7,6 @@
 // converge fails the run after the report is written.
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -18,15 +17,16 @@
 #include "mbot/motion/action_model_fit.hpp"
 #include "mbot/motion/wheel_odometry.hpp"
 #include "mbot/motion/motion_config.hpp"
+#include "mbot/reports/json.hpp"
 #include "report.hpp"
 #include "stages.hpp"
 
 namespace mbot::app {
 namespace {
 
-using drivers::EventKind;
 using motion::Pose2D;
 using motion::TimedPose;
+using msgs::EventKind;
 
 struct ActionModelFitStageOptions {
   motion::ActionModelFitOptions fit;
@@ -49,14 +49,14 @@ class ActionModelFitStage : public Stage {
     if (o_.encoder_odometry) wheel_ = std::make_unique<motion::WheelOdometry>(o_.wheels);
   }
 
-  void OnEvent(const drivers::Event& ev) override {
+  void OnEvent(const msgs::Event& ev) override {
     if (ev.kind == EventKind::kGroundTruth) {
       truth_.push_back({ev.t_us, std::get<Pose2D>(ev.payload)});
     } else if (ev.kind == EventKind::kOdometry && !o_.encoder_odometry) {
       if (o_.odometry_channel.empty()) o_.odometry_channel = ev.channel;
       if (ev.channel == o_.odometry_channel) Add(ev, std::get<Pose2D>(ev.payload));
     } else if (ev.kind == EventKind::kEncoders && wheel_) {
-      const auto& e = std::get<drivers::EncoderTicks>(ev.payload);
+      const auto& e = std::get<msgs::EncoderTicks>(ev.payload);
       Add(ev, wheel_->Update(e.left_ticks, e.right_ticks));
     }
   }
@@ -92,22 +92,29 @@ class ActionModelFitStage : public Stage {
     t << "  converged: " << (fit.converged ? "yes" : "no") << (fit.message.empty() ? "" : " - " + fit.message) << "\n";
     std::cout << t.str() << std::flush;
 
-    std::ostringstream j;
-    j << "{\n  \"source\": " << JsonString(ctx.source_path)
-      << ",\n  \"interrupted\": " << (interrupted ? "true" : "false")
-      << ",\n  \"odometry\": " << JsonString(o_.encoder_odometry ? "encoders" : o_.odometry_channel)
-      << ",\n  \"paired_samples\": " << odo.size() << ",\n  \"unpaired_samples\": " << odometry_.size() - odo.size()
-      << ",\n  \"window_steps\": " << o_.fit.window_steps << ",\n  \"windows_used\": " << fit.windows_used
-      << ",\n  \"windows_skipped\": " << fit.windows_skipped
-      << ",\n  \"converged\": " << (fit.converged ? "true" : "false") << ",\n  \"message\": " << JsonString(fit.message)
-      << ",\n  \"nll\": " << Num(fit.nll) << ",\n  \"k1\": " << Num(fit.k1) << ", \"k1_std\": " << Num(fit.k1_std)
-      << ", \"k1_95\": [" << Num(std::max(0.0, fit.k1 - z * fit.k1_std)) << ", " << Num(fit.k1 + z * fit.k1_std) << "]"
-      << ",\n  \"k2\": " << Num(fit.k2) << ", \"k2_std\": " << Num(fit.k2_std) << ", \"k2_95\": ["
-      << Num(std::max(0.0, fit.k2 - z * fit.k2_std)) << ", " << Num(fit.k2 + z * fit.k2_std) << "]"
-      << ",\n  \"reports\": [{\"k1\": " << kReportK[0][0] << ", \"k2\": " << kReportK[0][1]
-      << ", \"from\": \"seed report\"}, {\"k1\": " << kReportK[1][0] << ", \"k2\": " << kReportK[1][1]
-      << ", \"from\": \"second report\"}]\n}\n";
-    WriteFileAtomically(ctx.output_dir + "/action_model_fit.json", [&](std::ostream& out) { out << j.str(); });
+    using reports::Number;
+    const reports::Json j = {
+        {"source", ctx.source_path},
+        {"interrupted", interrupted},
+        {"odometry", o_.encoder_odometry ? "encoders" : o_.odometry_channel},
+        {"paired_samples", odo.size()},
+        {"unpaired_samples", odometry_.size() - odo.size()},
+        {"window_steps", o_.fit.window_steps},
+        {"windows_used", fit.windows_used},
+        {"windows_skipped", fit.windows_skipped},
+        {"converged", fit.converged},
+        {"message", fit.message},
+        {"nll", Number(fit.nll)},
+        {"k1", Number(fit.k1)},
+        {"k1_std", Number(fit.k1_std)},
+        {"k1_95", {Number(std::max(0.0, fit.k1 - z * fit.k1_std)), Number(fit.k1 + z * fit.k1_std)}},
+        {"k2", Number(fit.k2)},
+        {"k2_std", Number(fit.k2_std)},
+        {"k2_95", {Number(std::max(0.0, fit.k2 - z * fit.k2_std)), Number(fit.k2 + z * fit.k2_std)}},
+        {"reports",
+         {{{"k1", Number(kReportK[0][0])}, {"k2", Number(kReportK[0][1])}, {"from", "seed report"}},
+          {{"k1", Number(kReportK[1][0])}, {"k2", Number(kReportK[1][1])}, {"from", "second report"}}}}};
+    reports::WriteJson(ctx.output_dir + "/action_model_fit.json", j);
     if (!fit.converged) {
       if (interrupted) return;
       throw std::runtime_error("action_model_fit: the fit did not converge: " + fit.message + " (report in " +
@@ -123,31 +130,20 @@ class ActionModelFitStage : public Stage {
   }
 
  private:
-  void Add(const drivers::Event& ev, const Pose2D& pose) {
+  void Add(const msgs::Event& ev, const Pose2D& pose) {
     odometry_.push_back({ev.t_us, pose});
     stamps_.push_back(ev.stamp_us);
   }
 
-  // A logger writes messages when they arrive, and a robot's messages can arrive in bursts over a
-  // second late; the ground truth is placed on the log clock. With odometry_on_stamps, each
-  // odometry sample is placed at its own stamp plus the clock offset of the least-delayed message
-  // (min over messages of event time − stamp), which removes the bursts' delay.
+  // With odometry_on_stamps, each odometry sample goes to its own stamp on the log clock
+  // (motion::PlaceOnStamps), which removes the delays of a burst of late messages.
   void PlaceOnLogClock() {
-    if (!o_.odometry_on_stamps || stamps_.empty()) return;
-    for (int64_t s : stamps_) {
-      if (s <= 0) return;  // a source without stamps: keep the event times
+    if (!o_.odometry_on_stamps) return;
+    const double max_delay = motion::PlaceOnStamps(&odometry_, stamps_);
+    if (max_delay >= 0) {
+      mbot::log::Info("action_model_fit: odometry placed by its stamps; the log delayed it by up to " +
+                      Num(max_delay, 3) + " s");
     }
-    int64_t offset = std::numeric_limits<int64_t>::max();
-    for (size_t i = 0; i < odometry_.size(); ++i) offset = std::min(offset, odometry_[i].t_us - stamps_[i]);
-    double max_delay = 0;
-    for (size_t i = 0; i < odometry_.size(); ++i) {
-      max_delay = std::max(max_delay, (odometry_[i].t_us - stamps_[i] - offset) * 1e-6);
-      odometry_[i].t_us = stamps_[i] + offset;
-    }
-    std::sort(odometry_.begin(), odometry_.end(),
-              [](const TimedPose& a, const TimedPose& b) { return a.t_us < b.t_us; });
-    mbot::log::Info("action_model_fit: odometry placed by its stamps; the log delayed it by up to " +
-                    Num(max_delay, 3) + " s");
   }
 
   ActionModelFitStageOptions o_;
@@ -158,7 +154,7 @@ class ActionModelFitStage : public Stage {
 
 }  // namespace
 
-StageType ActionModelFitStageType() {
+static StageType ActionModelFitStageType() {
   return {
       "action_model_fit",
       "maximum-likelihood fit of the action model's k1, k2 from odometry against ground truth; writes an INI snippet "
@@ -193,5 +189,7 @@ StageType ActionModelFitStageType() {
         return std::make_unique<ActionModelFitStage>(o);
       }};
 }
+
+const RegisterStage kActionModelFitRegistered{ActionModelFitStageType()};
 
 }  // namespace mbot::app

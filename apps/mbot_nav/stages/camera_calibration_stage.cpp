@@ -12,7 +12,9 @@
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/vision/camera_calibration.hpp"
+#include "mbot/vision/frame.hpp"
 #include "mbot/vision/images.hpp"
+#include "mbot/reports/json.hpp"
 #include "report.hpp"
 #include "stages.hpp"
 
@@ -21,48 +23,60 @@ namespace {
 
 struct CameraCalibrationOptions {
   vision::ChessboardOptions board;
-  std::string images;
-  int every = 1;
+  int every = 1;  // use every n-th frame of the source
 };
 
-std::string Json(const vision::CalibrationResult& r, const CameraCalibrationOptions& o) {
-  std::ostringstream j;
-  j << "{\n  \"images\": " << JsonString(o.images) << ",\n  \"board\": {\"inner_cols\": " << o.board.inner_cols
-    << ", \"inner_rows\": " << o.board.inner_rows << ", \"square_m\": " << Num(o.board.square_m) << "},\n"
-    << "  \"image_width\": " << r.image_width << ", \"image_height\": " << r.image_height
-    << ",\n  \"flags\": " << r.flags << ",\n  \"views\": " << r.views.size() << ", \"used\": " << r.UsedViews()
-    << ",\n  \"calibrated\": " << (r.calibrated ? "true" : "false")
-    << ", \"accepted\": " << (r.accepted ? "true" : "false") << ",\n  \"verdict\": " << JsonString(r.verdict);
+reports::Json Json(const vision::CalibrationResult& r, const CameraCalibrationOptions& o, const std::string& images) {
+  using reports::Number;
+  reports::Json j = {{"images", images},
+                     {"board",
+                      {{"inner_cols", o.board.inner_cols},
+                       {"inner_rows", o.board.inner_rows},
+                       {"square_m", Number(o.board.square_m)}}},
+                     {"image_width", r.image_width},
+                     {"image_height", r.image_height},
+                     {"flags", r.flags},
+                     {"views", r.views.size()},
+                     {"used", r.UsedViews()},
+                     {"calibrated", r.calibrated},
+                     {"accepted", r.accepted},
+                     {"verdict", r.verdict}};
   if (r.calibrated) {
     const cv::Mat& k = r.camera_matrix;
-    j << ",\n  \"fx\": " << Num(k.at<double>(0, 0)) << ", \"fy\": " << Num(k.at<double>(1, 1))
-      << ", \"cx\": " << Num(k.at<double>(0, 2)) << ", \"cy\": " << Num(k.at<double>(1, 2)) << ",\n  \"distortion\": [";
-    for (int i = 0; i < r.distortion.rows; ++i) j << (i ? ", " : "") << Num(r.distortion.at<double>(i, 0));
-    j << "],\n  \"avg_reprojection_error_px\": " << Num(r.avg_error_px);
+    j["fx"] = Number(k.at<double>(0, 0));
+    j["fy"] = Number(k.at<double>(1, 1));
+    j["cx"] = Number(k.at<double>(0, 2));
+    j["cy"] = Number(k.at<double>(1, 2));
+    j["distortion"] = reports::Json::array();
+    for (int i = 0; i < r.distortion.rows; ++i) j["distortion"].push_back(Number(r.distortion.at<double>(i, 0)));
+    j["avg_reprojection_error_px"] = Number(r.avg_error_px);
   }
-  j << ",\n  \"per_view\": [";
-  for (size_t i = 0; i < r.views.size(); ++i) {
-    const vision::CalibrationView& v = r.views[i];
-    j << (i ? ",\n    " : "\n    ") << "{\"view\": " << JsonString(v.name)
-      << ", \"board\": " << (v.found ? "true" : "false");
-    if (v.found && r.calibrated) j << ", \"error_px\": " << Num(v.error_px);
-    j << "}";
+  j["per_view"] = reports::Json::array();
+  for (const vision::CalibrationView& v : r.views) {
+    reports::Json view = {{"view", v.name}, {"board", v.found}};
+    if (v.found && r.calibrated) view["error_px"] = Number(v.error_px);
+    j["per_view"].push_back(std::move(view));
   }
-  j << "\n  ]\n}\n";
-  return j.str();
+  return j;
 }
 
 class CameraCalibrationStage : public Stage {
  public:
   explicit CameraCalibrationStage(CameraCalibrationOptions o) : o_(std::move(o)) {}
-  void OnEvent(const drivers::Event&) override {}
+  void Start(const RunContext& ctx) override { images_ = ctx.source_path; }
+  void OnEvent(const msgs::Event& ev) override {
+    if (ev.kind != msgs::EventKind::kCameraFrame) return;
+    const auto& frame = std::get<msgs::CameraFrame>(ev.payload);
+    if (frames_++ % o_.every == 0) views_.emplace_back(frame.name, vision::FrameImage(frame).clone());
+  }
 
   void Finish(const RunContext& ctx, bool interrupted) override {
     if (interrupted) return;
-    const auto views = vision::ReadViews(o_.images, o_.every);
+    const auto& views = views_;
+    if (views.empty()) throw std::runtime_error(images_ + ": no camera frames (is [source] type = camera?)");
     const vision::CalibrationResult r = vision::CalibrateChessboard(views, o_.board);
     const std::string dir = ctx.output_dir;
-    WriteFileAtomically(dir + "/calibration.json", [&](std::ostream& out) { out << Json(r, o_); });
+    reports::WriteJson(dir + "/calibration.json", Json(r, o_, images_));
     for (size_t i = 0; i < r.views.size(); ++i) {
       if (!r.views[i].found) continue;
       cv::Mat shown = vision::ToBgr(views[i].second);  // grey, BGR or BGRA views alike
@@ -86,7 +100,7 @@ class CameraCalibrationStage : public Stage {
     vision::WriteCameraYaml(r, o_.board, dir + "/camera.yaml");
     const cv::Mat& k = r.camera_matrix;
     WriteFileAtomically(dir + "/camera.ini", [&](std::ostream& out) {
-      out << "# Camera intrinsics from " << o_.images << " (" << r.verdict << ")\n[camera]\n"
+      out << "# Camera intrinsics from " << images_ << " (" << r.verdict << ")\n[camera]\n"
           << "image_width = " << r.image_width << "\nimage_height = " << r.image_height
           << "\nfx = " << Num(k.at<double>(0, 0), 10) << "\nfy = " << Num(k.at<double>(1, 1), 10)
           << "\ncx = " << Num(k.at<double>(0, 2), 10) << "\ncy = " << Num(k.at<double>(1, 2), 10) << "\ndistortion = ";
@@ -100,19 +114,21 @@ class CameraCalibrationStage : public Stage {
 
  private:
   CameraCalibrationOptions o_;
+  std::string images_;  // the source's path
+  long long frames_ = 0;
+  std::vector<std::pair<std::string, cv::Mat>> views_;
 };
 
 }  // namespace
 
-StageType CameraCalibrationStageType() {
+static StageType CameraCalibrationStageType() {
   return {"camera_calibration",
           "chessboard camera calibration (sub-pixel corners, cv::calibrateCamera) from a folder of images, an image or "
           "a video; writes camera.yaml with OpenCV's keys, camera.ini, calibration.json and PNGs",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             CameraCalibrationOptions o;
             vision::ChessboardOptions& b = o.board;
-            o.images = s.RequirePath("images", "a folder of images (sorted by name), one image, or a video");
-            o.every = s.GetInt("every_nth_frame", o.every, "video: use every n-th frame", 1, 100000);
+            o.every = s.GetInt("every_nth_frame", o.every, "use every n-th frame of the source (a video)", 1, 100000);
             b.inner_cols = s.GetInt("inner_cols", b.inner_cols, "inner corners along a row of the board", 2, 100);
             b.inner_rows = s.GetInt("inner_rows", b.inner_rows, "inner corners along a column of the board", 2, 100);
             b.square_m = s.GetDouble("square_m", b.square_m, "side of a square [m]", 1e-4, 10.0);
@@ -132,5 +148,7 @@ StageType CameraCalibrationStageType() {
             return std::make_unique<CameraCalibrationStage>(o);
           }};
 }
+
+const RegisterStage kCameraCalibrationRegistered{CameraCalibrationStageType()};
 
 }  // namespace mbot::app

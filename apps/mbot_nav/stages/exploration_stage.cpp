@@ -8,7 +8,7 @@
 #include "mbot/common/log.hpp"
 #include "mbot/planning/exploration.hpp"
 #include "mbot/planning/planning_config.hpp"
-#include "report.hpp"
+#include "mbot/reports/json.hpp"
 #include "stages.hpp"
 
 namespace mbot::app {
@@ -16,7 +16,7 @@ namespace {
 
 struct ExplorationStageOptions {
   planning::ExplorationOptions exploration;
-  drivers::EventKind pose_kind = drivers::EventKind::kReferencePose;
+  msgs::EventKind pose_kind = msgs::EventKind::kReferencePose;
   double update_period_s = 0.5;  // at most one explorer update per this much data time
   std::string json_file = "exploration.json";
 };
@@ -31,8 +31,8 @@ class ExplorationStage : public Stage {
  public:
   explicit ExplorationStage(ExplorationStageOptions o) : options_(std::move(o)), explorer_(options_.exploration) {}
 
-  void OnEvent(const drivers::Event& ev) override {
-    if (ev.kind == drivers::EventKind::kMap) {
+  void OnEvent(const msgs::Event& ev) override {
+    if (ev.kind == msgs::EventKind::kMap) {
       map_ = std::get<std::shared_ptr<const mapping::OccupancyGrid>>(ev.payload);
     } else if (ev.kind == options_.pose_kind) {
       pose_ = std::get<motion::Pose2D>(ev.payload);
@@ -54,22 +54,20 @@ class ExplorationStage : public Stage {
 
   void Finish(const RunContext& ctx, bool interrupted) override {
     const std::string path = ctx.output_dir + "/" + options_.json_file;
-    WriteFileAtomically(path, [&](std::ostream& out) {
-      out << "{\"final_state\": " << JsonString(planning::ToString(explorer_.state()))
-          << ", \"failure_reason\": " << JsonString(explorer_.failure_reason()) << ", \"updates\": " << updates_
-          << ", \"interrupted\": " << (interrupted ? "true" : "false") << ",\n \"decisions\": [";
-      for (size_t i = 0; i < decisions_.size(); ++i) {
-        const Decision& d = decisions_[i];
-        out << (i ? ",\n  " : "\n  ") << "{\"t\": " << Num(d.t_s, 12) << ", \"state\": " << JsonString(d.state)
-            << ", \"reason\": " << JsonString(d.reason) << ", \"path\": [";
-        for (size_t k = 0; k < d.path.size(); ++k) {
-          out << (k ? ", " : "") << "[" << Num(d.path[k].x) << ", " << Num(d.path[k].y) << ", " << Num(d.path[k].theta)
-              << "]";
-        }
-        out << "]}";
+    reports::Json decisions = reports::Json::array();
+    for (const Decision& d : decisions_) {
+      reports::Json poses = reports::Json::array();
+      for (const motion::Pose2D& p : d.path) {
+        poses.push_back({reports::Number(p.x), reports::Number(p.y), reports::Number(p.theta)});
       }
-      out << "\n ]}\n";
-    });
+      decisions.push_back(
+          {{"t", reports::Number(d.t_s, 12)}, {"state", d.state}, {"reason", d.reason}, {"path", std::move(poses)}});
+    }
+    reports::WriteJson(path, {{"final_state", planning::ToString(explorer_.state())},
+                              {"failure_reason", explorer_.failure_reason()},
+                              {"updates", updates_},
+                              {"interrupted", interrupted},
+                              {"decisions", std::move(decisions)}});
     std::cout << "exploration: " << updates_ << " updates, " << decisions_.size() << " decisions, final state "
               << planning::ToString(explorer_.state())
               << (explorer_.failure_reason().empty() ? "" : " (" + explorer_.failure_reason() + ")") << "\n";
@@ -90,7 +88,7 @@ class ExplorationStage : public Stage {
 
 }  // namespace
 
-StageType ExplorationStageType() {
+static StageType ExplorationStageType() {
   return {"exploration",
           "runs the frontier-exploration state machine on the stream's maps and poses and records its paths and states",
           [](config::Section& s) -> std::unique_ptr<Stage> {
@@ -98,9 +96,9 @@ StageType ExplorationStageType() {
             const std::string pose =
                 s.GetChoice("pose", "reference_pose", {"reference_pose", "ground_truth", "odometry"},
                             "which pose stream is the robot's pose (SLAM output is reference_pose)");
-            o.pose_kind = pose == "ground_truth" ? drivers::EventKind::kGroundTruth
-                          : pose == "odometry"   ? drivers::EventKind::kOdometry
-                                                 : drivers::EventKind::kReferencePose;
+            o.pose_kind = pose == "ground_truth" ? msgs::EventKind::kGroundTruth
+                          : pose == "odometry"   ? msgs::EventKind::kOdometry
+                                                 : msgs::EventKind::kReferencePose;
             o.update_period_s = s.GetDouble("update_period_s", o.update_period_s,
                                             "at most one explorer update per this much data time [s]", 0.0, 3600.0);
             o.json_file = s.GetString("json_file", o.json_file, "decision log in output.dir");
@@ -108,5 +106,7 @@ StageType ExplorationStageType() {
             return std::make_unique<ExplorationStage>(o);
           }};
 }
+
+const RegisterStage kExplorationRegistered{ExplorationStageType()};
 
 }  // namespace mbot::app

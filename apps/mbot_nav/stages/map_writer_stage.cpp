@@ -3,6 +3,7 @@
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/drivers/map_io.hpp"
+#include "mbot/mapping/occupancy_grid.hpp"
 #include "stages.hpp"
 
 namespace mbot::app {
@@ -20,8 +21,8 @@ class MapWriterStage : public Stage {
  public:
   explicit MapWriterStage(MapWriterOptions o) : options_(std::move(o)) {}
 
-  void OnEvent(const drivers::Event& ev) override {
-    if (ev.kind != drivers::EventKind::kMap) return;
+  void OnEvent(const msgs::Event& ev) override {
+    if (ev.kind != msgs::EventKind::kMap) return;
     if (!options_.channel.empty() && ev.channel != options_.channel) return;
     map_ = std::get<std::shared_ptr<const mapping::OccupancyGrid>>(ev.payload);
   }
@@ -47,7 +48,7 @@ class MapWriterStage : public Stage {
 
 }  // namespace
 
-StageType MapWriterStageType() {
+static StageType MapWriterStageType() {
   return {"map_writer", "writes the last map of the input as botlab .map, ROS PGM + YAML and PNG",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             MapWriterOptions o;
@@ -60,5 +61,7 @@ StageType MapWriterStageType() {
             return std::make_unique<MapWriterStage>(o);
           }};
 }
+
+const RegisterStage kMapWriterRegistered{MapWriterStageType()};
 
 }  // namespace mbot::app

@@ -25,7 +25,7 @@ struct MazeGeneratorOptions {
 class MazeGeneratorStage : public Stage {
  public:
   explicit MazeGeneratorStage(MazeGeneratorOptions o) : o_(std::move(o)) {}
-  void OnEvent(const drivers::Event&) override {}
+  void OnEvent(const msgs::Event&) override {}
 
   void Finish(const RunContext& ctx, bool /*interrupted*/) override {
     std::ostringstream index;
@@ -57,7 +57,7 @@ class MazeGeneratorStage : public Stage {
 
 }  // namespace
 
-StageType MazeGeneratorStageType() {
+static StageType MazeGeneratorStageType() {
   return {"maze_generator",
           "writes seeded botlab-style mazes (perfect maze + loops, long corridors, open rooms, dead ends) as arena "
           "files with a PNG each and mazes.csv",
@@ -98,5 +98,7 @@ StageType MazeGeneratorStageType() {
             return std::make_unique<MazeGeneratorStage>(o);
           }};
 }
+
+const RegisterStage kMazeGeneratorRegistered{MazeGeneratorStageType()};
 
 }  // namespace mbot::app

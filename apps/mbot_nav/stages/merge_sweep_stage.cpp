@@ -11,7 +11,7 @@ namespace {
 class MergeSweepStage : public Stage {
  public:
   explicit MergeSweepStage(std::string into) : into_(std::move(into)) {}
-  void OnEvent(const drivers::Event&) override {}
+  void OnEvent(const msgs::Event&) override {}
 
   void Finish(const RunContext& ctx, bool /*interrupted*/) override {
     const std::string into = into_.empty() ? ctx.source_path : into_;
@@ -31,7 +31,7 @@ class MergeSweepStage : public Stage {
 
 }  // namespace
 
-StageType MergeSweepStageType() {
+static StageType MergeSweepStageType() {
   return {"merge_sweep",
           "merges a sweep folder's job outputs (score.json, metrics.json) into sweep.csv, sweep.md (per axis value: "
           "median, min, max, failures) and a PNG plot per metric",
@@ -40,5 +40,7 @@ StageType MergeSweepStageType() {
                 s.GetPath("into", "", "folder for sweep.csv, sweep.md and plots/ ('' = the sweep folder itself)"));
           }};
 }
+
+const RegisterStage kMergeSweepRegistered{MergeSweepStageType()};
 
 }  // namespace mbot::app

@@ -13,21 +13,23 @@
 #include "mbot/vision/tag_observer.hpp"
 #include "mbot/vision/vision_config.hpp"
 #include "report.hpp"
+#include "mbot/msgs/topics.hpp"
+#include "mbot/reports/mission_report.hpp"
 #include "stages.hpp"
 
 namespace mbot::app {
 namespace {
 
-using drivers::Event;
-using drivers::EventKind;
+using msgs::Event;
+using msgs::EventKind;
 
 struct MissionStageOptions {
   mission::MissionOptions mission;
-  std::string status_channel = "MISSION_STATUS";
-  std::string path_channel = "CONTROLLER_PATH";  // follow: paths sent by a GUI arrive here
-  std::string command_channel = "MBOT_VEL_CMD";
-  std::string fork_channel = "MBOT_FORKLIFT_CMD";  // heavy_lift: the tines' target height
-  vision::CameraMount camera;                      // heavy_lift: where the tags' camera sits on the robot
+  std::string status_channel = msgs::topics::kMissionStatus;
+  std::string path_channel = msgs::topics::kPath;  // follow: paths sent by a GUI arrive here
+  std::string command_channel = msgs::topics::kVelocityCommand;
+  std::string fork_channel = msgs::topics::kForkliftCommand;  // heavy_lift: the tines' target height
+  vision::CameraMount camera;                                 // heavy_lift: where the tags' camera sits on the robot
   double status_every_s = 0.0;  // also repeat the last state this often (a lossy link); 0: on change only
 };
 
@@ -38,6 +40,7 @@ class MissionStage : public Stage {
   void Start(const RunContext& ctx) override {
     bus_ = ctx.bus;
     mission_ = std::make_unique<mission::Mission>(o_.mission, ctx.seed);
+    mission_->set_watched(bus_ && bus_->Watched());
   }
 
   void OnEvent(const Event& ev) override {
@@ -46,19 +49,27 @@ class MissionStage : public Stage {
       case EventKind::kMap: return mission_->OnMap(std::get<std::shared_ptr<const mapping::OccupancyGrid>>(ev.payload));
       case EventKind::kSlamStatus: return mission_->OnSlamState(std::get<mapping::SlamStatus>(ev.payload).state);
       case EventKind::kPath:
-        if (ev.channel == o_.path_channel) mission_->OnPath(std::get<drivers::Path>(ev.payload).poses);
+        if (ev.channel == o_.path_channel) mission_->OnPath(std::get<msgs::Path>(ev.payload).poses);
         return;
       case EventKind::kTagSightings: {
         std::vector<mission::TagSeen> seen;
-        for (const drivers::TagSighting& t : std::get<drivers::TagSightings>(ev.payload).tags) {
+        for (const msgs::TagSighting& t : std::get<msgs::TagSightings>(ev.payload).tags) {
           const vision::TagOnRobot r =
               vision::TagInRobotFrame(o_.camera, {t.x_m, t.y_m, t.z_m}, {t.qw, t.qx, t.qy, t.qz});
           seen.push_back({t.id, r.position[0], r.position[1], r.position[2], r.facing_rad});
         }
         return mission_->OnTags(ev.t_us, seen);
       }
+      case EventKind::kGoal:  // a person's goal (the viewer)
+        if (const auto* g = std::get_if<motion::Pose2D>(&ev.payload)) mission_->OnGoal(*g);
+        return;
+      case EventKind::kTeleop:  // a person driving (the viewer's keys)
+        if (const auto* c = std::get_if<msgs::MotorCommand>(&ev.payload)) {
+          mission_->OnTeleop(ev.t_us, c->velocity.v_m_s, c->velocity.w_rad_s);
+        }
+        return;
       case EventKind::kForkliftStatus: {
-        const auto& f = std::get<drivers::ForkliftStatus>(ev.payload);
+        const auto& f = std::get<msgs::ForkliftStatus>(ev.payload);
         return mission_->OnForklift({f.height_m, f.target_m, f.crate_id, f.carrying});
       }
       case EventKind::kOdometry:
@@ -73,35 +84,8 @@ class MissionStage : public Stage {
 
   void Finish(const RunContext& ctx, bool interrupted) override {
     const mission::MissionReport r = mission_->Report();
-    std::ostringstream j;
-    j << "{\n  \"task\": " << JsonString(mission::ToString(r.task))
-      << ",\n  \"state\": " << JsonString(ToString(r.status.state))
-      << ",\n  \"detail\": " << JsonString(r.status.detail)
-      << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"commands\": " << r.commands
-      << ",\n  \"paths\": " << r.paths << ",\n  \"stale_pose_stops\": " << r.stale_pose_stops
-      << ",\n  \"corrections\": " << r.corrections << ",\n  \"stall_recoveries\": " << r.stall_recoveries
-      << ",\n  \"odometry_restarts\": " << r.odometry_restarts << ",\n  \"rounds\": " << r.rounds;
-    if (r.task == mission::TaskKind::kWarehouse)
-      j << ",\n  \"stops\": " << r.stops << ",\n  \"stops_done\": " << r.stops_done;
-    if (r.task == mission::TaskKind::kHeavyLift) {
-      j << ",\n  \"crates\": " << r.crates << ",\n  \"crates_lifted\": " << r.crates_lifted
-        << ",\n  \"crates_set_down\": " << r.crates_set_down << ",\n  \"tag_sightings\": " << r.tag_sightings;
-    }
-    if (r.task == mission::TaskKind::kExplore || o_.mission.explore_first) {
-      j << ",\n  \"frontiers_left\": [";
-      for (size_t i = 0; i < r.frontiers_left.size(); ++i) {
-        const planning::FrontierLeft& f = r.frontiers_left[i];
-        j << (i ? ",\n    " : "\n    ") << "{\"x\": " << f.x << ", \"y\": " << f.y << ", \"cells\": " << f.cells
-          << ", \"reachable\": " << (f.reachable ? "true" : "false") << ", \"given_up\": "
-          << (f.unresolved    ? "\"for good\""
-              : f.blacklisted ? "\"for a while\""
-                              : "false")
-          << "}";
-      }
-      j << (r.frontiers_left.empty() ? "]" : "\n  ]");
-    }
-    j << "\n}\n";
-    WriteFileAtomically(ctx.output_dir + "/mission.json", [&](std::ostream& out) { out << j.str(); });
+    const bool explored = r.task == mission::TaskKind::kExplore || o_.mission.explore_first;
+    reports::WriteJson(ctx.output_dir + "/mission.json", reports::MissionJson(r, interrupted, explored));
     if ((r.task == mission::TaskKind::kExplore || o_.mission.explore_first) && mission_->map()) {
       // What the frontier detection saw in the last map: faint cells, frontier cells, the frontiers left.
       const auto& frontier = o_.mission.exploration.frontier;
@@ -126,14 +110,20 @@ class MissionStage : public Stage {
       last_status_ = *s;
       last_status_us_ = t_us;
     } else if (const auto* p = std::get_if<mission::PathOut>(&out)) {
-      bus_->Emit(this, Event{t_us, t_us, o_.path_channel, EventKind::kPath, drivers::Path{p->poses}});
+      bus_->Emit(this, Event{t_us, t_us, o_.path_channel, EventKind::kPath, msgs::Path{p->poses}});
+    } else if (const auto* x = std::get_if<mission::ExplorationOut>(&out)) {
+      bus_->Emit(this, Event{t_us, t_us, msgs::topics::kFrontiers, EventKind::kFrontiers, x->frontiers});
+      if (x->distances) {
+        bus_->Emit(this, Event{t_us, t_us, msgs::topics::kObstacleDistance, EventKind::kObstacleDistance,
+                               std::shared_ptr<const msgs::DistanceGrid>(x->distances)});
+      }
     } else if (const auto* f = std::get_if<mission::ForkOut>(&out)) {
-      bus_->Emit(
-          this, Event{t_us, t_us, o_.fork_channel, EventKind::kForkliftCommand, drivers::ForkliftCommand{f->height_m}});
+      bus_->Emit(this,
+                 Event{t_us, t_us, o_.fork_channel, EventKind::kForkliftCommand, msgs::ForkliftCommand{f->height_m}});
     } else {
       const auto& c = std::get<motion::VelocityCommand>(out);
       bus_->Emit(this, Event{t_us, t_us, o_.command_channel, EventKind::kMotorCommand,
-                             drivers::MotorCommand::Velocity(c.v_m_s, c.w_rad_s)});
+                             msgs::MotorCommand::Velocity(c.v_m_s, c.w_rad_s)});
     }
   }
 
@@ -154,7 +144,7 @@ class MissionStage : public Stage {
 
 }  // namespace
 
-StageType MissionStageType() {
+static StageType MissionStageType() {
   return {"mission",
           "the autonomy after SLAM (libs/mission): drives a circuit of waypoints, explores and returns home, makes the "
           "Warehouse's deliveries, follows a GUI's paths or stacks crates by their tags (Heavy Lift); emits velocity "
@@ -176,5 +166,7 @@ StageType MissionStageType() {
             return std::make_unique<MissionStage>(o);
           }};
 }
+
+const RegisterStage kMissionRegistered{MissionStageType()};
 
 }  // namespace mbot::app

@@ -8,6 +8,7 @@
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/drivers/plot.hpp"
+#include "mbot/reports/json.hpp"
 #include "report.hpp"
 
 namespace mbot::app {
@@ -41,34 +42,39 @@ void PrintMotorFit(const motion::MotorFitReport& r, const std::string& origin, c
   std::cout << t.str() << std::flush;
 }
 
-std::string LineJson(const motion::LineFit& f) {
-  return "{\"fitted\": " + std::string(f.fitted ? "true" : "false") + ", \"slope\": " + Num(f.line.slope) +
-         ", \"punch\": " + Num(f.line.punch) + ", \"samples\": " + std::to_string(f.samples) +
-         ", \"residual_rms\": " + Num(f.residual_rms) + "}";
+reports::Json LineJson(const motion::LineFit& f) {
+  return {{"fitted", f.fitted},
+          {"slope", reports::Number(f.line.slope)},
+          {"punch", reports::Number(f.line.punch)},
+          {"samples", f.samples},
+          {"residual_rms", reports::Number(f.residual_rms)}};
 }
 
 void WriteMotorFitJson(const MotorCalibrationStageOptions& o, const std::string& path, const motion::MotorFitReport& r,
                        const std::string& origin, const std::vector<MotorSample>* s, const RunContext& ctx,
                        bool interrupted) {
-  std::ostringstream j;
-  j << "{\n  \"source\": " << JsonString(ctx.source_path) << ",\n  \"samples_from\": " << JsonString(origin)
-    << ",\n  \"interrupted\": " << (interrupted ? "true" : "false")
-    << ",\n  \"acceptable\": " << (r.acceptable ? "true" : "false") << ",\n  \"problems\": [";
-  for (size_t i = 0; i < r.problems.size(); ++i) j << (i ? ", " : "") << JsonString(r.problems[i]);
-  j << "],\n  \"limits\": {\"max_abs_slope\": " << Num(o.fit.max_abs_slope)
-    << ", \"max_abs_punch\": " << Num(o.fit.max_abs_punch) << "}";
+  reports::Json j = {{"source", ctx.source_path},
+                     {"samples_from", origin},
+                     {"interrupted", interrupted},
+                     {"acceptable", r.acceptable},
+                     {"problems", r.problems},
+                     {"limits",
+                      {{"max_abs_slope", reports::Number(o.fit.max_abs_slope)},
+                       {"max_abs_punch", reports::Number(o.fit.max_abs_punch)}}}};
   const auto wheel = [&](const char* name, const motion::WheelFit& w, const motion::WheelCalibration& c, size_t n) {
-    j << ",\n  \"" << name << "\": {\"samples\": " << n << ", \"moving_samples\": " << w.moving_samples
-      << ", \"disagreeing_samples\": " << w.disagreeing_samples
-      << ", \"encoder_counting\": " << (w.encoder_counting ? "true" : "false")
-      << ", \"polarity_ok\": " << (w.polarity_ok ? "true" : "false") << ", \"motor_polarity\": " << c.motor_polarity
-      << ", \"encoder_polarity\": " << c.encoder_polarity << ",\n    \"forward\": " << LineJson(w.forward)
-      << ",\n    \"backward\": " << LineJson(w.backward) << "}";
+    j[name] = {{"samples", n},
+               {"moving_samples", w.moving_samples},
+               {"disagreeing_samples", w.disagreeing_samples},
+               {"encoder_counting", w.encoder_counting},
+               {"polarity_ok", w.polarity_ok},
+               {"motor_polarity", c.motor_polarity},
+               {"encoder_polarity", c.encoder_polarity},
+               {"forward", LineJson(w.forward)},
+               {"backward", LineJson(w.backward)}};
   };
   wheel("left", r.left, r.calibration.left, s[0].size());
   wheel("right", r.right, r.calibration.right, s[1].size());
-  j << "\n}\n";
-  WriteFileAtomically(path, [&](std::ostream& out) { out << j.str(); });
+  reports::WriteJson(path, j);
 }
 
 void WriteMotorSnippet(const MotorCalibrationStageOptions& o, const std::string& path, const motion::MotorFitReport& r,

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "../stage.hpp"
+#include "stages.hpp"
 #include "mbot/motion/motor_model.hpp"
 #include "mbot/motion/robot_geometry.hpp"
 

@@ -27,18 +27,18 @@
 namespace mbot::app {
 namespace {
 
-using drivers::EventKind;
 using motion::MotorSample;
+using msgs::EventKind;
 
 class MotorCalibrationStage : public Stage {
  public:
   explicit MotorCalibrationStage(MotorCalibrationStageOptions o)
       : o_(std::move(o)), log_samples_(o_.settle_s, o_.duty_tolerance, o_.geometry.RadPerTick()) {}
 
-  void OnEvent(const drivers::Event& ev) override {
+  void OnEvent(const msgs::Event& ev) override {
     const int64_t t = ev.t_us;
     if (ev.kind == EventKind::kMotorSample) {
-      const auto& s = std::get<drivers::WheelSample>(ev.payload);
+      const auto& s = std::get<msgs::WheelSample>(ev.payload);
       if (s.channel == o_.left_channel) {
         csv_[0].push_back({s.duty, s.speed_rad_s});
       } else if (s.channel == o_.right_channel) {
@@ -47,13 +47,13 @@ class MotorCalibrationStage : public Stage {
         ++unmapped_channel_samples_;
       }
     } else if (ev.kind == EventKind::kMotorCommand) {
-      const auto& c = std::get<drivers::MotorCommand>(ev.payload);
-      if (c.kind == drivers::MotorCommand::Kind::kPwm) log_samples_.OnDuty(t, c.left_duty, c.right_duty);
+      const auto& c = std::get<msgs::MotorCommand>(ev.payload);
+      if (c.kind == msgs::MotorCommand::Kind::kPwm) log_samples_.OnDuty(t, c.left_duty, c.right_duty);
     } else if (ev.kind == EventKind::kWheelSpeed) {
-      const auto& w = std::get<drivers::WheelSpeeds>(ev.payload);
+      const auto& w = std::get<msgs::WheelSpeeds>(ev.payload);
       log_samples_.OnWheelSpeeds(t, w.left_rad_s, w.right_rad_s);
     } else if (ev.kind == EventKind::kEncoders) {
-      const auto& e = std::get<drivers::EncoderTicks>(ev.payload);
+      const auto& e = std::get<msgs::EncoderTicks>(ev.payload);
       log_samples_.OnEncoderTicks(t, e.left_ticks, e.right_ticks, e.delta_time_us);
     }
   }
@@ -114,7 +114,7 @@ int Polarity(config::Section& s, const std::string& key, const std::string& doc)
 
 }  // namespace
 
-StageType MotorCalibrationStageType() {
+static StageType MotorCalibrationStageType() {
   return {
       "motor_calibration",
       "fits the motor model (slope, punch per wheel and direction) from calibration samples or a log's PWM and "
@@ -165,5 +165,7 @@ StageType MotorCalibrationStageType() {
         return std::make_unique<MotorCalibrationStage>(o);
       }};
 }
+
+const RegisterStage kMotorCalibrationRegistered{MotorCalibrationStageType()};
 
 }  // namespace mbot::app

@@ -11,9 +11,10 @@
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/planning/astar.hpp"
+#include "mbot/planning/benchmark_rules.hpp"
 #include "mbot/planning/obstacle_distance_grid.hpp"
 #include "mbot/planning/planning_config.hpp"
-#include "report.hpp"
+#include "mbot/reports/json.hpp"
 #include "stages.hpp"
 
 namespace mbot::app {
@@ -31,35 +32,17 @@ struct MovingAiBenchmarkOptions {
   bool compare_astar = false;  // also run A* on every scenario: its times, its optimality, the speed-up
 };
 
-struct Row {
-  int index = 0, bucket = 0;
-  bool found = false;
-  double length = 0.0, optimal = 0.0, time_us = 0.0;
-  int64_t expansions = 0;
-  double astar_length = 0.0, astar_time_us = 0.0;  // with compare_astar
-  bool astar_found = false;
-};
+using Row = planning::ScenarioResult;
 
 class MovingAiBenchmarkStage : public Stage {
  public:
   explicit MovingAiBenchmarkStage(MovingAiBenchmarkOptions o)
       : options_(std::move(o)),
-        planner_(PlannerOptions(options_.search)),
-        astar_(PlannerOptions(planning::SearchAlgorithm::kAStar)) {}
+        planner_(planning::MovingAiPlannerOptions(options_.search)),
+        astar_(planning::MovingAiPlannerOptions(planning::SearchAlgorithm::kAStar)) {}
 
-  static planning::AStarOptions PlannerOptions(planning::SearchAlgorithm search) {
-    planning::AStarOptions a;
-    a.search = search;
-    a.robot_radius_m = 0.0;
-    a.ease_start_m = 0.0;
-    a.ease_max_m = 0.0;
-    a.penalty_weight = 0.0;
-    a.prune = planning::PruneMode::kNone;
-    return a;
-  }
-
-  void OnEvent(const drivers::Event& ev) override {
-    if (ev.kind == drivers::EventKind::kMap) {
+  void OnEvent(const msgs::Event& ev) override {
+    if (ev.kind == msgs::EventKind::kMap) {
       map_name_ = ev.channel;
       const auto& grid = std::get<std::shared_ptr<const mapping::OccupancyGrid>>(ev.payload);
       if (grid->resolution() != 1.0)
@@ -69,9 +52,9 @@ class MovingAiBenchmarkStage : public Stage {
       if (options_.compare_astar) astar_.SetMap(distances);
       return;
     }
-    if (ev.kind != drivers::EventKind::kPlanRequest) return;
+    if (ev.kind != msgs::EventKind::kPlanRequest) return;
     if (map_name_ != ev.channel) throw std::runtime_error("movingai_benchmark: scenario before its map");
-    const auto& req = std::get<drivers::PlanRequest>(ev.payload);
+    const auto& req = std::get<msgs::PlanRequest>(ev.payload);
     if (req.index % options_.sample_every != 0) return;
     const auto t0 = Clock::now();
     const planning::PlanResult r = planner_.Plan(req.start, req.goal);
@@ -101,7 +84,7 @@ class MovingAiBenchmarkStage : public Stage {
     double total_us = 0.0;
     std::vector<const Row*> wrong;
     auto is_optimal = [&](bool ok, double length, double best) {
-      return ok && std::abs(length - best) <= options_.tolerance;
+      return planning::SolvedOptimally(ok, length, best, options_.tolerance);
     };
     for (const Row& r : rows_) {
       times.push_back(r.time_us);
@@ -133,7 +116,7 @@ class MovingAiBenchmarkStage : public Stage {
         out << "\n";
       }
     });
-    const SampleStats t = SampleStats::Of(times);
+    const reports::SampleStats t = reports::SampleStats::Of(times);
     const double rate = total_us > 0 ? expansions / (total_us * 1e-6) : 0.0;
     const char* search = planner_.UsesJumpPoints() ? "jps" : "astar";
     char buf[512];
@@ -143,7 +126,7 @@ class MovingAiBenchmarkStage : public Stage {
                   map_name_.c_str(), search, rows_.size(), found, optimal, options_.tolerance, t.mean, t.median, t.max,
                   rate * 1e-6);
     std::cout << buf;
-    const SampleStats a = SampleStats::Of(astar_times);
+    const reports::SampleStats a = reports::SampleStats::Of(astar_times);
     if (compare) {
       std::snprintf(buf, sizeof buf,
                     "  A* on the same queries: %d optimal; mean %.1f us, median %.1f us; speed-up of the mean %.2fx\n",
@@ -155,17 +138,17 @@ class MovingAiBenchmarkStage : public Stage {
                   wrong[i]->length, wrong[i]->optimal,
                   compare ? (" (A* " + std::to_string(wrong[i]->astar_length) + ")").c_str() : "");
     }
-    WriteFileAtomically(ctx.output_dir + "/" + options_.json_file, [&](std::ostream& out) {
-      out << "{\"map\": " << JsonString(map_name_) << ", \"search\": \"" << search
-          << "\", \"problems\": " << rows_.size() << ", \"found\": " << found << ", \"optimal\": " << optimal
-          << ", \"tolerance\": " << Num(options_.tolerance) << ", \"time_us\": " << t.Json()
-          << ", \"expansions\": " << expansions << ", \"expansions_per_s\": " << Num(rate);
-      if (compare) {
-        out << ", \"astar\": {\"optimal\": " << astar_optimal << ", \"time_us\": " << a.Json()
-            << ", \"speedup_of_mean\": " << Num(t.mean > 0 ? a.mean / t.mean : 0.0) << "}";
-      }
-      out << ", \"interrupted\": " << (interrupted ? "true" : "false") << "}\n";
-    });
+    reports::Json j = {
+        {"map", map_name_},      {"search", search},         {"problems", rows_.size()},
+        {"found", found},        {"optimal", optimal},       {"tolerance", reports::Number(options_.tolerance)},
+        {"time_us", t.ToJson()}, {"expansions", expansions}, {"expansions_per_s", reports::Number(rate)}};
+    if (compare) {
+      j["astar"] = {{"optimal", astar_optimal},
+                    {"time_us", a.ToJson()},
+                    {"speedup_of_mean", reports::Number(t.mean > 0 ? a.mean / t.mean : 0.0)}};
+    }
+    j["interrupted"] = interrupted;
+    reports::WriteJson(ctx.output_dir + "/" + options_.json_file, j);
     mbot::log::Info("wrote " + csv);
     if (options_.require_optimal && !wrong.empty() && !interrupted) {
       throw std::runtime_error("movingai_benchmark: " + std::to_string(wrong.size()) + " of " +
@@ -182,7 +165,7 @@ class MovingAiBenchmarkStage : public Stage {
 
 }  // namespace
 
-StageType MovingAiBenchmarkStageType() {
+static StageType MovingAiBenchmarkStageType() {
   return {"movingai_benchmark",
           "runs the scenarios of a Moving AI .map.scen file (all, or every sample_every-th) (octile, no corner "
           "cutting) and checks optimal lengths",
@@ -204,5 +187,7 @@ StageType MovingAiBenchmarkStageType() {
             return std::make_unique<MovingAiBenchmarkStage>(o);
           }};
 }
+
+const RegisterStage kMovingAiBenchmarkRegistered{MovingAiBenchmarkStageType()};
 
 }  // namespace mbot::app

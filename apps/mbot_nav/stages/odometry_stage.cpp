@@ -10,19 +10,21 @@
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/drivers/map_io.hpp"
+#include "mbot/mapping/occupancy_grid.hpp"
 #include "mbot/motion/gyrodometry.hpp"
 #include "mbot/motion/trajectory_error.hpp"
 #include "mbot/motion/motion_config.hpp"
+#include "mbot/reports/json.hpp"
 #include "report.hpp"
 #include "stages.hpp"
 
 namespace mbot::app {
 namespace {
 
-using drivers::EventKind;
 using motion::HeadingSource;
 using motion::Pose2D;
 using motion::TimedPose;
+using msgs::EventKind;
 
 const std::map<std::string, HeadingSource> kHeadings = {{"encoders", HeadingSource::kEncoders},
                                                         {"gyrodometry", HeadingSource::kGyrodometry},
@@ -52,16 +54,16 @@ class OdometryStage : public Stage {
     }
   }
 
-  void OnEvent(const drivers::Event& ev) override {
+  void OnEvent(const msgs::Event& ev) override {
     // Rates are integrated on the robot's own clock (message stamps): logged events can arrive in
     // bursts, and a burst would stretch or squeeze the integration.
     const int64_t t = options_.use_stamps && ev.stamp_us > 0 ? ev.stamp_us : ev.t_us;
     if (ev.kind == EventKind::kImu) {
-      const auto& imu = std::get<drivers::Imu>(ev.payload);
+      const auto& imu = std::get<msgs::Imu>(ev.payload);
       for (auto& v : variants_) v.odometry.AddImu(t, imu.gyro_rad_s[2], imu.angles_rpy_rad[2], imu.has_angles);
       ++imu_count_;
     } else if (ev.kind == EventKind::kEncoders) {
-      const auto& e = std::get<drivers::EncoderTicks>(ev.payload);
+      const auto& e = std::get<msgs::EncoderTicks>(ev.payload);
       for (auto& v : variants_) v.track.push_back({ev.t_us, v.odometry.AddEncoders(t, e.left_ticks, e.right_ticks)});
     } else if (ev.kind == EventKind::kGroundTruth) {
       truth_.push_back({ev.t_us, std::get<Pose2D>(ev.payload)});
@@ -76,10 +78,11 @@ class OdometryStage : public Stage {
     if (imu_count_ == 0)
       mbot::log::Warn("odometry: the source has no IMU messages; every heading mode equals encoders");
     const int64_t gap = static_cast<int64_t>(options_.max_pose_gap_s * 1e6);
-    std::ostringstream j;
-    j << "{\n  \"source\": " << JsonString(ctx.source_path)
-      << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"imu_messages\": " << imu_count_
-      << ",\n  \"ground_truth\": " << (truth_.empty() ? "false" : "true") << ",\n  \"variants\": {";
+    reports::Json j = {{"source", ctx.source_path},
+                       {"interrupted", interrupted},
+                       {"imu_messages", imu_count_},
+                       {"ground_truth", !truth_.empty()},
+                       {"variants", reports::Json::object()}};
     std::vector<drivers::MapOverlay> overlays;
     const uint8_t colours[][3] = {{220, 40, 40}, {40, 90, 230}, {0, 160, 120}, {200, 120, 0}};
     std::vector<Pose2D> truth_paired_first;
@@ -96,14 +99,16 @@ class OdometryStage : public Stage {
           truth.push_back(t);
         }
       }
-      j << (k ? "," : "") << "\n    " << JsonString(v.name) << ": {\"gyro_steps\": " << v.odometry.gyro_steps()
-        << ", \"gyro_bias_rad_s\": " << Num(v.odometry.gyro_bias_rad_s());
+      reports::Json& vj = j["variants"][v.name];
+      vj = {{"gyro_steps", v.odometry.gyro_steps()},
+            {"gyro_bias_rad_s", reports::Number(v.odometry.gyro_bias_rad_s())}};
       drivers::MapOverlay path{{}, colours[k % 4][0], colours[k % 4][1], colours[k % 4][2], false, v.name};
       if (!est.empty()) {
         const motion::TrajectoryErrors errors = motion::EvaluateTrajectory(est, truth);
         const motion::AteResult& aligned = errors.aligned;
         const motion::AteResult& anchored = errors.anchored;
-        j << ", \"aligned\": " << AteJson(aligned) << ", \"anchored\": " << AteJson(anchored);
+        vj["aligned"] = reports::AteJson(aligned);
+        vj["anchored"] = reports::AteJson(anchored);
         mbot::log::Info("odometry: " + v.name + ": aligned xy RMSE " + Num(aligned.xy.rmse, 3) + " m, theta RMSE " +
                         Num(aligned.theta.rmse * 180 / M_PI, 3) + " deg; anchored final heading error " +
                         Num(anchored.final_error.theta * 180 / M_PI, 3) + " deg");
@@ -112,13 +117,11 @@ class OdometryStage : public Stage {
       } else {
         for (const auto& p : v.track) path.poses.push_back(p.pose);
       }
-      j << "}";
       overlays.push_back(std::move(path));
     }
-    j << "\n  }\n}\n";
     if (!truth_paired_first.empty())
       overlays.push_back({truth_paired_first, 0, 0, 0, false, "ground truth (anchored frame)"});
-    WriteFileAtomically(ctx.output_dir + "/odometry.json", [&](std::ostream& o) { o << j.str(); });
+    reports::WriteJson(ctx.output_dir + "/odometry.json", j);
     WritePicture(overlays, ctx.output_dir + "/odometry_comparison.png");
     mbot::log::Info("odometry: wrote odometry_*.tum, odometry.json and odometry_comparison.png in " + ctx.output_dir);
   }
@@ -152,7 +155,7 @@ class OdometryStage : public Stage {
 
 }  // namespace
 
-StageType OdometryStageType() {
+static StageType OdometryStageType() {
   return {"odometry",
           "recomputes dead reckoning from encoders and IMU (encoders, gyrodometry, complementary, IMU yaw) and scores "
           "it against ground truth",
@@ -186,5 +189,7 @@ StageType OdometryStageType() {
             return std::make_unique<OdometryStage>(o);
           }};
 }
+
+const RegisterStage kOdometryRegistered{OdometryStageType()};
 
 }  // namespace mbot::app

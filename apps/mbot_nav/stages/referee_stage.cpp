@@ -5,82 +5,30 @@
 // (.map + PNG with the planned, driven and true paths, warehouse stops), the printed rubric and the
 // competition's table row.
 #include <chrono>
-#include <iomanip>
 #include <iostream>
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/drivers/map_io.hpp"
+#include "mbot/reports/score.hpp"
 #include "mbot/sim/referee.hpp"
 #include "report.hpp"
+#include "mbot/msgs/topics.hpp"
 #include "stages.hpp"
 
 namespace mbot::app {
 namespace {
 
-using drivers::EventKind;
 using motion::Pose2D;
+using msgs::EventKind;
 
 struct RefereeStageOptions {
   sim::RefereeOptions referee;
-  std::string mission_status_channel = "MISSION_STATUS";
+  std::string mission_status_channel = msgs::topics::kMissionStatus;
+  // The score so far, this often on the data's clock, when the run has an output (a viewer); 0: never.
+  double score_every_s = 1.0;
 };
-
-std::string ErrorJson(const sim::PoseError& e) {
-  return "{\"x_m\": " + Num(e.x_m) + ", \"y_m\": " + Num(e.y_m) + ", \"theta_deg\": " + Num(e.theta_deg) + "}";
-}
-
-// score.json: the score as the rubric counts it.
-std::string ScoreJson(const sim::Score& s, const RunContext& ctx, const std::string& arena, bool interrupted,
-                      double wall_s) {
-  const double rtf = wall_s > 0 ? s.sim_s / wall_s : 0.0;
-  std::ostringstream j;
-  j << "{\n  \"event\": " << JsonString(sim::ToString(s.event)) << ",\n  \"world\": " << JsonString(ctx.source_path)
-    << ",\n  \"arena\": " << JsonString(arena) << ",\n  \"seed\": " << ctx.seed
-    << ",\n  \"state\": " << JsonString(mission::ToString(s.state)) << ",\n  \"detail\": " << JsonString(s.detail)
-    << ",\n  \"completed\": " << (s.completed ? "true" : "false")
-    << ",\n  \"incomplete\": " << (s.incomplete ? "true" : "false")
-    << ",\n  \"timed_out\": " << (s.timed_out ? "true" : "false")
-    << ",\n  \"interrupted\": " << (interrupted ? "true" : "false") << ",\n  \"time_s\": " << Num(s.time_s)
-    << ",\n  \"sim_seconds\": " << Num(s.sim_s) << ",\n  \"wall_seconds\": " << Num(wall_s)
-    << ",\n  \"real_time_factor\": " << Num(rtf) << ",\n  \"collisions\": " << s.collisions
-    << ",\n  \"start\": " << PoseJson(s.start) << ",\n  \"final\": " << PoseJson(s.final_pose);
-  if (s.final_error) j << ",\n  \"final_error\": " << ErrorJson(*s.final_error);
-  if (s.slam_final_error) j << ",\n  \"slam_final_error\": " << ErrorJson(*s.slam_final_error);
-  if (s.map) {
-    j << ",\n  \"map\": {\"coverage\": " << Num(s.map->coverage)
-      << ", \"coverage_one_cell\": " << Num(s.map->coverage_one_cell)
-      << ", \"wall_precision\": " << Num(s.map->precision) << ", \"reachable_cells\": " << s.map->reachable_cells
-      << ", \"occupied_cells\": " << s.map->occupied_cells << "}";
-  }
-  if (s.event == sim::CompetitionEvent::kWarehouse) {
-    j << ",\n  \"localized_at_s\": " << (s.localized_at_s ? Num(*s.localized_at_s) : "null")
-      << ",\n  \"levels_reached\": " << s.levels_reached << ",\n  \"stops\": [";
-    for (size_t k = 0; k < s.stops.size(); ++k) {
-      const sim::StopResult& r = s.stops[k];
-      j << (k ? "," : "") << "\n    {\"stop\": " << JsonString(r.stop.Name()) << ", \"pose\": " << PoseJson(r.stop.pose)
-        << ", \"done_at_s\": " << (r.done_at_s ? Num(*r.done_at_s) : "null")
-        << ", \"missed\": " << (r.missed ? "true" : "false") << "}";
-    }
-    j << "\n  ]";
-  }
-  if (s.event == sim::CompetitionEvent::kHeavyLift) {
-    j << ",\n  \"crates\": [";
-    for (size_t k = 0; k < s.crates.size(); ++k) {
-      const sim::CrateResult& c = s.crates[k];
-      j << (k ? "," : "") << "\n    {\"id\": " << c.id << ", \"on\": " << c.on_id
-        << ", \"lifted\": " << (c.lifted ? "true" : "false") << ", \"stacked\": " << (c.stacked ? "true" : "false")
-        << ", \"fell\": " << (c.fell ? "true" : "false") << ", \"final\": " << PoseJson(c.final_pose)
-        << ", \"final_z_m\": " << Num(c.final_z_m) << "}";
-    }
-    j << "\n  ]";
-  }
-  j << ",\n  \"points\": {";
-  for (const sim::RubricItem& i : s.items) j << JsonString(i.name) << ": " << i.points << ", ";
-  j << "\"total\": " << s.total << ", \"max\": " << s.max_total << "}\n}\n";
-  return j.str();
-}
 
 class RefereeStage : public Stage {
  public:
@@ -98,15 +46,15 @@ class RefereeStage : public Stage {
     wall0_ = std::chrono::steady_clock::now();
   }
 
-  void OnEvent(const drivers::Event& ev) override {
+  void OnEvent(const msgs::Event& ev) override {
     referee_->Tick(ev.t_us);
     switch (ev.kind) {
       case EventKind::kGroundTruth: referee_->OnTruePose(ev.t_us, std::get<Pose2D>(ev.payload)); break;
       case EventKind::kCollision: referee_->OnCollision(); break;
-      case EventKind::kCrates: referee_->OnCrates(std::get<drivers::CrateStates>(ev.payload)); break;
+      case EventKind::kCrates: referee_->OnCrates(std::get<msgs::CrateStates>(ev.payload)); break;
       case EventKind::kPoseEstimate: referee_->OnSlamPose(ev.t_us, std::get<Pose2D>(ev.payload)); break;
       case EventKind::kMap: referee_->OnMap(std::get<std::shared_ptr<const mapping::OccupancyGrid>>(ev.payload)); break;
-      case EventKind::kPath: path_ = std::get<drivers::Path>(ev.payload).poses; break;
+      case EventKind::kPath: path_ = std::get<msgs::Path>(ev.payload).poses; break;
       case EventKind::kSlamStatus:
         referee_->OnSlamState(ev.t_us, std::get<mapping::SlamStatus>(ev.payload).state);
         break;
@@ -117,6 +65,7 @@ class RefereeStage : public Stage {
       default: break;
     }
     if (!bus_) return;
+    PublishScore(ev.t_us);
     if (const std::optional<std::string> why = referee_->StopReason(ev.t_us)) bus_->RequestStop(*why);
   }
 
@@ -127,20 +76,8 @@ class RefereeStage : public Stage {
       mbot::log::Warn("referee: no ground truth in the stream (is the source the simulator?); nothing scored");
       return;
     }
-    const std::string arena = referee_->world().name();
-    const std::string result = s.timed_out ? "time limit" : mission::ToString(s.state);
-    const double rtf = wall_s > 0 ? s.sim_s / wall_s : 0.0;
-    std::ostringstream t;
-    t << "\n"
-      << sim::Title(s.event) << " - arena " << arena << ", seed " << ctx.seed << ": " << result << " after "
-      << Num(s.time_s, 4) << " s (" << Num(rtf, 3) << "x real time), " << s.collisions << " collisions\n";
-    for (const sim::RubricItem& i : s.items) {
-      t << "  " << std::left << std::setw(20) << i.name << std::setw(68) << i.detail << std::right << std::setw(4)
-        << i.points << " / " << i.max << "\n";
-    }
-    t << "  " << std::left << std::setw(88) << "total" << std::right << std::setw(4) << s.total << " / " << s.max_total
-      << "\n";
-    std::cout << t.str() << std::flush;
+    const reports::ScoreContext c{ctx.source_path, referee_->world().name(), ctx.seed, interrupted, wall_s};
+    std::cout << reports::RubricText(s, c) << std::flush;
 
     const std::string dir = ctx.output_dir;
     WriteTum(dir + "/true_path.tum", "", referee_->truth());
@@ -163,16 +100,35 @@ class RefereeStage : public Stage {
         overlays.push_back({s.map->unmapped, 240, 140, 0, true, "reachable space not mapped"});
       drivers::WriteMapPngWithOverlays(mapping::CropToKnown(*map, 0.3), overlays, 4, dir + "/final_map.png");
     }
-    WriteFileAtomically(dir + "/score.json",
-                        [&](std::ostream& out) { out << ScoreJson(s, ctx, arena, interrupted, wall_s); });
+    reports::WriteJson(dir + "/score.json", reports::ScoreReport(s, c));
     if (ctx.event_result) {
-      *ctx.event_result =
-          EventResult{sim::Title(s.event), arena, ctx.seed, result, s.time_s, rtf, s.total, s.max_total, s.collisions};
+      *ctx.event_result = EventResult{sim::Title(s.event),
+                                      c.arena,
+                                      ctx.seed,
+                                      reports::ScoreResult(s),
+                                      s.time_s,
+                                      wall_s > 0 ? s.sim_s / wall_s : 0.0,
+                                      s.total,
+                                      s.max_total,
+                                      s.collisions};
     }
   }
 
  private:
+  void PublishScore(int64_t t_us) {
+    if (o_.score_every_s <= 0 || !bus_->Watched() ||
+        (last_score_us_ >= 0 && t_us - last_score_us_ < o_.score_every_s * 1e6))
+      return;
+    last_score_us_ = t_us;
+    const sim::Score s = referee_->Judge();
+    if (!s.scored) return;
+    msgs::ScoreStatus out{sim::Title(s.event), s.total, s.max_total, s.collisions, s.sim_s, {}};
+    for (const sim::RubricItem& i : s.items) out.items.push_back({i.name, i.detail, i.points, i.max});
+    bus_->Emit(this, msgs::Event{t_us, t_us, msgs::topics::kScore, EventKind::kScore, std::move(out)});
+  }
+
   RefereeStageOptions o_;
+  int64_t last_score_us_ = -1;
   std::unique_ptr<sim::Referee> referee_;
   Bus* bus_ = nullptr;
   std::chrono::steady_clock::time_point wall0_;
@@ -181,7 +137,7 @@ class RefereeStage : public Stage {
 
 }  // namespace
 
-StageType RefereeStageType() {
+static StageType RefereeStageType() {
   return {"referee",
           "scores a competition event on the simulator (libs/sim: pose tiers, map quality, time, collisions, crates "
           "lifted and stacked), ends the run "
@@ -205,8 +161,13 @@ StageType RefereeStageType() {
                                                  0, 1000));
             o.mission_status_channel =
                 s.GetString("mission_status_channel", o.mission_status_channel, "channel of the mission's states");
+            o.score_every_s =
+                s.GetDouble("score_every_s", o.score_every_s,
+                            "publish the score so far this often (data time, for a viewer; 0: never)", 0.0, 3600.0);
             return std::make_unique<RefereeStage>(o);
           }};
 }
+
+const RegisterStage kRefereeRegistered{RefereeStageType()};
 
 }  // namespace mbot::app

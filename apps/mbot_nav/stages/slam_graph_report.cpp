@@ -1,7 +1,6 @@
 #include "slam_graph_report.hpp"
 
 #include <map>
-#include <sstream>
 
 #include "mbot/common/log.hpp"
 #include "report.hpp"
@@ -9,13 +8,14 @@
 namespace mbot::app {
 namespace {
 
-std::string MeanStdJson(const motion::MeanStd& m) {
-  return "{\"mean\": " + Num(m.mean) + ", \"std\": " + Num(m.std) + "}";
-}
+using reports::Json;
+using reports::Number;
+
+Json MeanStdJson(const motion::MeanStd& m) { return {{"mean", Number(m.mean)}, {"std", Number(m.std)}}; }
 
 }  // namespace
 
-std::string GraphSlamJson(const mapping::GraphSlamStats& g) {
+Json GraphSlamJson(const mapping::GraphSlamStats& g) {
   mbot::log::Info("slam: graph of " + std::to_string(g.nodes) + " nodes in " + std::to_string(g.submaps) +
                   " submaps; " + std::to_string(g.loop_closures) + " loop closures from " +
                   std::to_string(g.loop_searches) + " searches, " + std::to_string(g.rejected.size()) +
@@ -27,23 +27,26 @@ std::string GraphSlamJson(const mapping::GraphSlamStats& g) {
         Num(r.score, 3) + ") rejected by the robust loss (residual " + Num(r.residual, 3) + ")" +
         (i == 4 && g.rejected.size() > 5 ? "; metrics.json lists all " + std::to_string(g.rejected.size()) : ""));
   }
-  std::ostringstream j;
-  j << "{\"nodes\": " << g.nodes << ", \"submaps\": " << g.submaps << ", \"sparse_scans\": " << g.sparse_scans
-    << ", \"loop_searches\": " << g.loop_searches << ", \"loop_closures\": " << g.loop_closures
-    << ", \"optimizations\": " << g.optimizations << ", \"front_end_s\": " << Num(g.front_end_s)
-    << ", \"loop_search_s\": " << Num(g.loop_search_s) << ", \"optimize_s\": " << Num(g.optimize_s)
-    << ", \"render_s\": " << Num(g.render_s) << ", \"apply_max_s\": " << Num(g.apply_max_s)
-    << ", \"rejected_closures\": [";
-  for (size_t i = 0; i < g.rejected.size(); ++i) {
-    const mapping::RejectedClosure& r = g.rejected[i];
-    j << (i ? ", " : "") << "{\"node\": " << r.node << ", \"submap\": " << r.submap << ", \"score\": " << Num(r.score)
-      << ", \"residual\": " << Num(r.residual) << "}";
+  Json rejected = Json::array();
+  for (const mapping::RejectedClosure& r : g.rejected) {
+    rejected.push_back(
+        {{"node", r.node}, {"submap", r.submap}, {"score", Number(r.score)}, {"residual", Number(r.residual)}});
   }
-  j << "]}";
-  return j.str();
+  return {{"nodes", g.nodes},
+          {"submaps", g.submaps},
+          {"sparse_scans", g.sparse_scans},
+          {"loop_searches", g.loop_searches},
+          {"loop_closures", g.loop_closures},
+          {"optimizations", g.optimizations},
+          {"front_end_s", Number(g.front_end_s)},
+          {"loop_search_s", Number(g.loop_search_s)},
+          {"optimize_s", Number(g.optimize_s)},
+          {"render_s", Number(g.render_s)},
+          {"apply_max_s", Number(g.apply_max_s)},
+          {"rejected_closures", std::move(rejected)}};
 }
 
-std::string RelationsJson(const std::string& file, const std::vector<motion::TimedPose>& path, std::string* error) {
+Json RelationsJson(const std::string& file, const std::vector<motion::TimedPose>& path, std::string* error) {
   std::map<int64_t, motion::Pose2D> poses;
   for (const motion::TimedPose& p : path) poses.emplace(p.t_us, p.pose);
   motion::RelationErrors e;
@@ -51,18 +54,20 @@ std::string RelationsJson(const std::string& file, const std::vector<motion::Tim
     e = motion::ScoreRelations(motion::ReadRelations(file), poses, file);
   } catch (const motion::RelationsError& x) {
     *error = x.what();
-    return "{\"error\": " + JsonString(*error) + "}";
+    return {{"error", *error}};
   }
   mbot::log::Info("slam: relations (" + file + ", " + std::to_string(e.scored) + " of " + std::to_string(e.relations) +
                   " scored): translation " + Num(e.trans_m.mean, 4) + " +- " + Num(e.trans_m.std, 4) + " m, rotation " +
                   Num(e.rot_deg.mean, 3) + " +- " + Num(e.rot_deg.std, 3) + " deg");
-  std::ostringstream j;
-  j << "{\"file\": " << JsonString(file) << ", \"relations\": " << e.relations << ", \"scored\": " << e.scored
-    << ", \"translation_m\": " << MeanStdJson(e.trans_m) << ", \"rotation_deg\": " << MeanStdJson(e.rot_deg)
-    << ", \"translation_sq_m2\": " << MeanStdJson(e.trans_sq_m2)
-    << ", \"rotation_sq_deg2\": " << MeanStdJson(e.rot_sq_deg2) << ", \"max_translation_m\": " << Num(e.max_trans_m)
-    << ", \"max_rotation_deg\": " << Num(e.max_rot_deg) << "}";
-  return j.str();
+  return {{"file", file},
+          {"relations", e.relations},
+          {"scored", e.scored},
+          {"translation_m", MeanStdJson(e.trans_m)},
+          {"rotation_deg", MeanStdJson(e.rot_deg)},
+          {"translation_sq_m2", MeanStdJson(e.trans_sq_m2)},
+          {"rotation_sq_deg2", MeanStdJson(e.rot_sq_deg2)},
+          {"max_translation_m", Number(e.max_trans_m)},
+          {"max_rotation_deg", Number(e.max_rot_deg)}};
 }
 
 }  // namespace mbot::app

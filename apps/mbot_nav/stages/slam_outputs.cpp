@@ -14,6 +14,7 @@
 namespace mbot::app {
 namespace {
 
+using mapping::ScanRecord;
 using motion::Pose2D;
 using motion::TimedPose;
 
@@ -40,27 +41,17 @@ void WriteScansCsv(const std::string& path, const std::vector<ScanRecord>& recor
 
 }  // namespace
 
-void PairRecordsAndTrim(SlamInputs* inputs, std::vector<ScanRecord>* records, RecordPairing* paired,
-                        int64_t scan_start_us, int64_t max_gap_us) {
-  auto pair = [&](const std::vector<TimedPose>& series, size_t* next, std::optional<Pose2D> ScanRecord::*field) {
-    while (*next < records->size() && !series.empty() && series.back().t_us >= (*records)[*next].t_us) {
-      Pose2D p;
-      if (motion::InterpolateAt(series, (*records)[*next].t_us, max_gap_us, &p)) (*records)[*next].*field = p;
-      ++*next;
-    }
-    return *next < records->size() ? (*records)[*next].t_us : INT64_MAX;
-  };
-  const int64_t waiting = std::min(pair(inputs->ground_truth(), &paired->truth, &ScanRecord::truth),
-                                   pair(inputs->reference(), &paired->reference, &ScanRecord::reference));
-  inputs->TrimBefore(std::min(waiting, scan_start_us) - 2 * max_gap_us);
-}
-
-void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& run) {
-  const SlamStageOptions& options = *run.options;
-  const std::vector<ScanRecord>& records = *run.records;
+void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamStageOptions& options,
+                      const mapping::SlamSession& session, double wall_s) {
+  const std::vector<ScanRecord>& records = session.records();
+  const mapping::SlamInputs& inputs = session.inputs();
+  const std::vector<TimedPose>& reference = inputs.reference();
+  const std::vector<TimedPose>& ground_truth = inputs.ground_truth();
+  const std::vector<mapping::ScanSample::Item>& scan_points = session.scan_points();
+  const int64_t first_t_us = inputs.first_t_us(), last_t_us = inputs.last_t_us();
   const std::string dir = ctx.output_dir + "/";
-  const int64_t max_gap = static_cast<int64_t>(options.max_pose_gap_s * 1e6);
-  const std::vector<TimedPose>& truth_series = options.truth_is_reference ? *run.reference : *run.ground_truth;
+  const int64_t max_gap = static_cast<int64_t>(options.session.max_pose_gap_s * 1e6);
+  const std::vector<TimedPose>& truth_series = options.truth_is_reference ? reference : ground_truth;
   const std::string truth_name = options.truth_is_reference ? "reference" : "ground truth";
 
   // Each scan's pose against the truth at its time: within the scoring window and not too late.
@@ -81,31 +72,32 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& ru
     truth_path.push_back({tum_t, t});
     const bool late = options.score_max_latency_us > 0 && r.latency_us > options.score_max_latency_us;
     unscored_late += late;
-    if (r.t_us < options.score_from_us + run.first_t_us || late) continue;
+    if (r.t_us < options.score_from_us + first_t_us || late) continue;
     est_paired.push_back(r.slam);
     odo_paired.push_back(r.odometry);
     truth_paired.push_back(t);
     Pose2D ref;
     if (!options.truth_is_reference &&
-        (r.reference ? (ref = *r.reference, true) : motion::InterpolateAt(*run.reference, r.t_us, max_gap, &ref))) {
+        (r.reference ? (ref = *r.reference, true) : motion::InterpolateAt(reference, r.t_us, max_gap, &ref))) {
       ref_paired.push_back(ref);
       ref_truth_paired.push_back(t);
     }
   }
-  WriteTum(dir + "slam.tum", std::string("SLAM (") + mapping::ToString(options.slam.mode) + ")", slam_path);
+  WriteTum(dir + "slam.tum", std::string("SLAM (") + mapping::ToString(options.session.slam.mode) + ")", slam_path);
   WriteTum(dir + "odometry.tum", "odometry at the scan times", odometry_path);
   WriteScansCsv(dir + "slam_scans.csv", records);
   if (!truth_path.empty()) WriteTum(dir + "ground_truth.tum", truth_name + " at the scan times", truth_path);
 
-  const mapping::OccupancyGrid& map = run.slam->map();
+  const mapping::OccupancyGrid& map = session.slam().map();
   const std::string base = dir + options.map_basename;
-  if (options.slam.mode != mapping::SlamMode::kLocalization) {
+  if (session.slam().BuildsMap()) {
     drivers::WriteBotlabMap(map, base + ".map");
     drivers::WriteRosMap(map, base + ".yaml");
     if (options.octomap_height_m > 0) drivers::WriteOctomap(map, options.octomap_height_m, base + ".bt");
   }
   std::vector<drivers::MapOverlay> overlays;
-  if (!run.particle_snapshots->empty()) overlays.push_back({*run.particle_snapshots, 255, 160, 0, true, "particles"});
+  if (!session.particle_snapshots().empty())
+    overlays.push_back({session.particle_snapshots(), 255, 160, 0, true, "particles"});
   if (!truth_path.empty()) overlays.push_back({PosesOf(truth_path), 0, 170, 0, false, truth_name});
   overlays.push_back({PosesOf(odometry_path), 220, 0, 0, false, "odometry"});
   overlays.push_back({PosesOf(slam_path), 0, 60, 255, false, "SLAM"});
@@ -114,13 +106,13 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& ru
   // Map sharpness: the share of every scan's returns that end within inlier_distance_m of an
   // obstacle of the final map, at the pose the scan was given (blurred or doubled walls lower it).
   double consistency = NAN;
-  if (!run.scan_points->empty()) {
-    mapping::SensorModel model(options.slam.sensor);
+  if (!scan_points.empty()) {
+    mapping::SensorModel model(options.session.slam.sensor);
     model.SetMap(map);
     double sum = 0;
-    for (size_t i = 0; i < run.scan_points->size(); ++i)
-      sum += model.InlierFraction(records[(*run.scan_points)[i].index].slam, (*run.scan_points)[i].value);
-    consistency = sum / run.scan_points->size();
+    for (size_t i = 0; i < scan_points.size(); ++i)
+      sum += model.InlierFraction(records[scan_points[i].index].slam, scan_points[i].value);
+    consistency = sum / scan_points.size();
   }
   std::vector<double> update_ms, filter_ms, ess;
   int updates = 0;
@@ -128,22 +120,25 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& ru
     update_ms.push_back(r.update_ms);
     if (r.updated) ++updates, filter_ms.push_back(r.update_ms), ess.push_back(r.status.ess);
   }
-  const double data_s = (run.last_t_us - run.first_t_us) * 1e-6;
-  std::ostringstream j;
-  j << "{\n  \"mode\": " << JsonString(mapping::ToString(options.slam.mode)) << ",\n  \"seed\": " << ctx.seed
-    << ",\n  \"interrupted\": " << (interrupted ? "true" : "false")
-    << ",\n  \"source\": " << JsonString(ctx.source_path) << ",\n  \"scans\": " << records.size()
-    << ",\n  \"scans_skipped\": " << run.skipped_scans << ",\n  \"filter_updates\": " << updates
-    << ",\n  \"particles\": " << options.slam.filter.particles
-    << ",\n  \"truth\": " << JsonString(truth_series.empty() ? "none" : truth_name)
-    << ",\n  \"scans_not_scored_late\": " << unscored_late;
+  const double data_s = (last_t_us - first_t_us) * 1e-6;
+  reports::Json j;
+  j["mode"] = mapping::ToString(options.session.slam.mode);
+  j["seed"] = ctx.seed;
+  j["interrupted"] = interrupted;
+  j["source"] = ctx.source_path;
+  j["scans"] = records.size();
+  j["scans_skipped"] = session.skipped_scans();
+  j["filter_updates"] = updates;
+  j["particles"] = options.session.slam.filter.particles;
+  j["truth"] = truth_series.empty() ? "none" : truth_name;
+  j["scans_not_scored_late"] = unscored_late;
   if (!est_paired.empty()) {
     const motion::TrajectoryErrors slam_errors = motion::EvaluateTrajectory(est_paired, truth_paired);
     const motion::TrajectoryErrors odo_errors = motion::EvaluateTrajectory(odo_paired, truth_paired);
-    j << ",\n  \"slam_ate\": " << TrajectoryErrorsJson(slam_errors)
-      << ",\n  \"odometry_ate\": " << TrajectoryErrorsJson(odo_errors);
+    j["slam_ate"] = reports::TrajectoryErrorsJson(slam_errors);
+    j["odometry_ate"] = reports::TrajectoryErrorsJson(odo_errors);
     if (!ref_paired.empty())
-      j << ",\n  \"reference_ate\": " << TrajectoryErrorsJson(motion::EvaluateTrajectory(ref_paired, ref_truth_paired));
+      j["reference_ate"] = reports::TrajectoryErrorsJson(motion::EvaluateTrajectory(ref_paired, ref_truth_paired));
     const motion::AteResult& a = slam_errors.aligned;
     const motion::AteResult& o = odo_errors.aligned;
     mbot::log::Info("slam: ATE vs " + truth_name + " (aligned, " + std::to_string(a.samples) + " scans): RMSE x " +
@@ -151,44 +146,48 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamRun& ru
                     Num(a.theta.rmse * 180 / M_PI, 3) + " deg; odometry xy " + Num(o.xy.rmse, 3) + " m, theta " +
                     Num(o.theta.rmse * 180 / M_PI, 3) + " deg");
   }
-  if (const mapping::GraphSlam* g = run.slam->graph()) j << ",\n  \"graph\": " << GraphSlamJson(g->stats());
+  if (const mapping::GraphSlam* g = session.slam().graph()) j["graph"] = GraphSlamJson(g->stats());
   // A relations file that does not fit the run is an error, but only once everything else is written.
   std::string relations_error;
   if (!options.relations_file.empty())
-    j << ",\n  \"relations\": " << RelationsJson(options.relations_file, slam_path, &relations_error);
-  const mapping::SlamEventTracker& ev = *run.events;
-  j << ",\n  \"global_localization\": ";
-  if (!ev.global()) {
-    j << "null";
-  } else {
-    j << "{\"converged\": " << (ev.converged_at_s() >= 0 ? "true" : "false")
-      << ", \"converged_at_s\": " << Num(ev.converged_at_s()) << ", \"converged_at_scan\": " << ev.converged_at_scan()
-      << "}";
+    j["relations"] = RelationsJson(options.relations_file, slam_path, &relations_error);
+  const mapping::SlamEventTracker& ev = session.events();
+  j["global_localization"] = nullptr;
+  if (ev.global()) {
+    j["global_localization"] = {{"converged", ev.converged_at_s() >= 0},
+                                {"converged_at_s", reports::Number(ev.converged_at_s())},
+                                {"converged_at_scan", ev.converged_at_scan()}};
   }
-  j << ",\n  \"kidnapping\": "
-    << (run.kidnapped_at_us < 0 ? std::string("null")
-                                : "{\"at_s\": " + Num((run.kidnapped_at_us - run.first_t_us) * 1e-6) + "}");
-  j << ",\n  \"lost\": [";
-  for (size_t i = 0; i < ev.lost().size(); ++i) {
-    const mapping::SlamEventTracker::Lost& l = ev.lost()[i];
+  j["kidnapping"] = nullptr;
+  if (inputs.kidnapped_at_us() >= 0) {
+    j["kidnapping"] = {{"at_s", reports::Number((inputs.kidnapped_at_us() - first_t_us) * 1e-6)}};
+  }
+  reports::Json lost = reports::Json::array();
+  for (const mapping::SlamEventTracker::Lost& l : ev.lost()) {
     const bool recovered = l.recovered_at_scan >= 0;
-    j << (i ? ", " : "") << "{\"at_s\": " << Num(l.at_s) << ", \"at_scan\": " << l.at_scan
-      << ", \"recovered_at_s\": " << (recovered ? Num(l.recovered_at_s) : "null")
-      << ", \"scans_to_recover\": " << (recovered ? std::to_string(l.recovered_at_scan - l.at_scan) : "null") << "}";
+    lost.push_back(
+        {{"at_s", reports::Number(l.at_s)},
+         {"at_scan", l.at_scan},
+         {"recovered_at_s", recovered ? reports::Number(l.recovered_at_s) : reports::Json(nullptr)},
+         {"scans_to_recover", recovered ? reports::Json(l.recovered_at_scan - l.at_scan) : reports::Json(nullptr)}});
   }
-  j << "]";
-  j << ",\n  \"effective_sample_size\": " << SampleStats::Of(ess).Json()
-    << ",\n  \"timing\": {\"scan_update_ms\": " << SampleStats::Of(update_ms).Json()
-    << ", \"filter_update_ms\": " << SampleStats::Of(filter_ms).Json() << ", \"wall_s\": " << Num(run.wall_s)
-    << ", \"data_s\": " << Num(data_s) << ", \"real_time_factor\": " << Num(run.wall_s > 0 ? data_s / run.wall_s : NAN)
-    << "}"
-    << ",\n  \"map\": {\"scan_consistency\": " << Num(consistency) << ", \"width\": " << map.width()
-    << ", \"height\": " << map.height() << ", \"resolution\": " << Num(map.resolution())
-    << ", \"origin_x\": " << Num(map.origin_x()) << ", \"origin_y\": " << Num(map.origin_y()) << "}\n}\n";
-  WriteFileAtomically(dir + "metrics.json", [&](std::ostream& o) { o << j.str(); });
+  j["lost"] = std::move(lost);
+  j["effective_sample_size"] = reports::SampleStats::Of(ess).ToJson();
+  j["timing"] = {{"scan_update_ms", reports::SampleStats::Of(update_ms).ToJson()},
+                 {"filter_update_ms", reports::SampleStats::Of(filter_ms).ToJson()},
+                 {"wall_s", reports::Number(wall_s)},
+                 {"data_s", reports::Number(data_s)},
+                 {"real_time_factor", reports::Number(wall_s > 0 ? data_s / wall_s : NAN)}};
+  j["map"] = {{"scan_consistency", reports::Number(consistency)},
+              {"width", map.width()},
+              {"height", map.height()},
+              {"resolution", reports::Number(map.resolution())},
+              {"origin_x", reports::Number(map.origin_x())},
+              {"origin_y", reports::Number(map.origin_y())}};
+  reports::WriteJson(dir + "metrics.json", j);
   mbot::log::Info("slam: " + std::to_string(records.size()) + " scans (" + std::to_string(updates) +
                   " filter updates), scan consistency " + Num(consistency, 3) + ", median " +
-                  Num(SampleStats::Of(update_ms).median, 3) + " ms per scan; outputs in " + ctx.output_dir);
+                  Num(reports::SampleStats::Of(update_ms).median, 3) + " ms per scan; outputs in " + ctx.output_dir);
   if (!relations_error.empty()) throw motion::RelationsError(relations_error);
 }
 

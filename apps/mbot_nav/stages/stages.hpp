@@ -1,28 +1,21 @@
-// The stage types this application registers (one function per stage file).
+// What a stage file of the app includes: the pipeline's contract (libs/msgs) under the app's names.
+// A stage file registers its type itself (const RegisterStage k...{...}); a new stage is that file
+// plus its line in CMakeLists.txt.
 #pragma once
 
-#include "../stage.hpp"
+#include "mbot/msgs/stage.hpp"
 
 namespace mbot::app {
 
-StageType InspectStageType();
-StageType TrajectoryWriterStageType();
-StageType MapWriterStageType();
-StageType AStarTestStageType();
-StageType MovingAiBenchmarkStageType();
-StageType ExplorationStageType();
-StageType SlamStageType();
-StageType OdometryStageType();
-StageType MotorCalibrationStageType();
-StageType ActionModelFitStageType();
-StageType MissionStageType();
-StageType RefereeStageType();
-StageType RecorderStageType();
-StageType LcmBridgeStageType();
-StageType MazeGeneratorStageType();
-StageType CameraCalibrationStageType();
-StageType TagDetectionStageType();
-StageType TagSightingsStageType();
-StageType MergeSweepStageType();
+using msgs::Bus;
+using msgs::EventResult;
+using msgs::RegisterStage;
+using msgs::RunContext;
+using msgs::Stage;
+using msgs::StageType;
+
+// Calls every library's registration function (source, stage and output types), in the order of
+// the build (generated from mbot_register() in CMake). Idempotent.
+void RegisterAll();
 
 }  // namespace mbot::app

@@ -11,9 +11,10 @@
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/vision/apriltag_detector.hpp"
+#include "mbot/vision/frame.hpp"
 #include "mbot/vision/images.hpp"
 #include "mbot/vision/vision_config.hpp"
-#include "report.hpp"
+#include "mbot/reports/json.hpp"
 #include "stages.hpp"
 
 namespace mbot::app {
@@ -21,8 +22,7 @@ namespace {
 
 struct TagDetectionOptions {
   vision::TagDetectorOptions detector;
-  std::string images;
-  int every = 1;
+  int every = 1;  // use every n-th frame of the source
   bool annotate = true;
   int timing_repeats = 1;  // detect each frame this many times; the time is their median
 };
@@ -30,11 +30,17 @@ struct TagDetectionOptions {
 class TagDetectionStage : public Stage {
  public:
   explicit TagDetectionStage(TagDetectionOptions o) : o_(std::move(o)), detector_(o_.detector) {}
-  void OnEvent(const drivers::Event&) override {}
+  void Start(const RunContext& ctx) override { images_ = ctx.source_path; }
+  void OnEvent(const msgs::Event& ev) override {
+    if (ev.kind != msgs::EventKind::kCameraFrame) return;
+    const auto& frame = std::get<msgs::CameraFrame>(ev.payload);
+    if (frames_++ % o_.every == 0) views_.emplace_back(frame.name, vision::FrameImage(frame).clone());
+  }
 
   void Finish(const RunContext& ctx, bool interrupted) override {
     if (interrupted) return;
-    const auto views = vision::ReadViews(o_.images, o_.every);
+    const auto& views = views_;
+    if (views.empty()) throw std::runtime_error(images_ + ": no camera frames (is [source] type = camera?)");
     const bool video = !views.empty() && views[0].first.rfind("frame ", 0) == 0;
     std::ostringstream csv;
     csv << "image,id,x0,y0,x1,y1,x2,y2,x3,y3,margin\n";
@@ -72,16 +78,19 @@ class TagDetectionStage : public Stage {
     std::vector<double> sorted = ms;
     std::sort(sorted.begin(), sorted.end());
     const double median = sorted[sorted.size() / 2];
-    std::ostringstream j;
-    j << "{\n  \"images\": " << JsonString(o_.images) << ",\n  \"family\": " << JsonString(o_.detector.family)
-      << ",\n  \"decimate\": " << Num(o_.detector.decimate)
-      << ", \"refine_edges\": " << (o_.detector.refine_edges ? "true" : "false")
-      << ", \"threads\": " << o_.detector.threads << ",\n  \"frames\": " << views.size()
-      << ", \"detections\": " << total << ",\n  \"per_id\": {";
-    bool first = true;
-    for (const auto& [id, n] : per_id) j << (first ? "" : ", ") << "\"" << id << "\": " << n, first = false;
-    j << "},\n  \"ms_per_frame\": {\"median\": " << Num(median) << ", \"max\": " << Num(sorted.back()) << "}\n}\n";
-    WriteFileAtomically(ctx.output_dir + "/tags.json", [&](std::ostream& out) { out << j.str(); });
+    reports::Json ids = reports::Json::object();
+    for (const auto& [id, n] : per_id) ids[std::to_string(id)] = n;
+    reports::WriteJson(
+        ctx.output_dir + "/tags.json",
+        {{"images", images_},
+         {"family", o_.detector.family},
+         {"decimate", reports::Number(o_.detector.decimate)},
+         {"refine_edges", o_.detector.refine_edges},
+         {"threads", o_.detector.threads},
+         {"frames", views.size()},
+         {"detections", total},
+         {"per_id", std::move(ids)},
+         {"ms_per_frame", {{"median", reports::Number(median)}, {"max", reports::Number(sorted.back())}}}});
     std::printf("tag_detection: %zu tags in %zu frames (%s), median %.2f ms per frame; tags.csv, tags.json in %s\n",
                 total, views.size(), o_.detector.family.c_str(), median, ctx.output_dir.c_str());
   }
@@ -89,18 +98,20 @@ class TagDetectionStage : public Stage {
  private:
   TagDetectionOptions o_;
   vision::TagDetector detector_;
+  std::string images_;  // the source's path
+  long long frames_ = 0;
+  std::vector<std::pair<std::string, cv::Mat>> views_;
 };
 
 }  // namespace
 
-StageType TagDetectionStageType() {
+static StageType TagDetectionStageType() {
   return {"tag_detection",
           "AprilTag detection with the reference detector on a folder of images, an image or a video; writes "
           "tags.csv, tags.json and annotated PNGs",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             TagDetectionOptions o;
-            o.images = s.RequirePath("images", "a folder of images (sorted by name), one image, or a video");
-            o.every = s.GetInt("every_nth_frame", o.every, "video: use every n-th frame", 1, 100000);
+            o.every = s.GetInt("every_nth_frame", o.every, "use every n-th frame of the source (a video)", 1, 100000);
             o.timing_repeats = s.GetInt("timing_repeats", o.timing_repeats,
                                         "detect each frame this many times and report the median time", 1, 10000);
             o.annotate =
@@ -109,5 +120,7 @@ StageType TagDetectionStageType() {
             return std::make_unique<TagDetectionStage>(o);
           }};
 }
+
+const RegisterStage kTagDetectionRegistered{TagDetectionStageType()};
 
 }  // namespace mbot::app

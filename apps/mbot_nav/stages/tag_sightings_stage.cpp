@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "mbot/common/atomic_file.hpp"
@@ -18,7 +19,8 @@
 #include "mbot/vision/images.hpp"
 #include "mbot/vision/tag_observer.hpp"
 #include "mbot/vision/vision_config.hpp"
-#include "report.hpp"
+#include "mbot/reports/json.hpp"
+#include "mbot/msgs/topics.hpp"
 #include "stages.hpp"
 
 namespace mbot::app {
@@ -27,35 +29,34 @@ namespace {
 struct TagSightingsOptions {
   vision::TagObserverOptions observer;
   std::string camera_yaml;
-  std::string channel = "MBOT_APRILTAG_ARRAY";
+  std::string channel = msgs::topics::kTags;
 };
 
 class TagSightingsStage : public Stage {
  public:
-  explicit TagSightingsStage(TagSightingsOptions o)
-      : o_(std::move(o)), observer_(o_.observer, vision::IntrinsicsFromYaml(o_.camera_yaml)) {}
+  explicit TagSightingsStage(TagSightingsOptions o) : o_(std::move(o)) {}
 
   void Start(const RunContext& ctx) override {
+    observer_.emplace(o_.observer, vision::IntrinsicsFromYaml(o_.camera_yaml));  // files open at start
     bus_ = ctx.bus;
     output_dir_ = ctx.output_dir;
     csv_ << "t_s,frame,id,x_m,y_m,z_m,robot_x_m,robot_y_m,bearing_deg,reprojection_px,margin\n";
   }
 
-  void OnEvent(const drivers::Event& ev) override {
-    if (ev.kind == drivers::EventKind::kForkliftStatus)
-      return ForkliftChanged(std::get<drivers::ForkliftStatus>(ev.payload));
-    if (ev.kind != drivers::EventKind::kCameraFrame) return;
-    const auto& frame = std::get<drivers::CameraFrame>(ev.payload);
+  void OnEvent(const msgs::Event& ev) override {
+    if (ev.kind == msgs::EventKind::kForkliftStatus) return ForkliftChanged(std::get<msgs::ForkliftStatus>(ev.payload));
+    if (ev.kind != msgs::EventKind::kCameraFrame) return;
+    const auto& frame = std::get<msgs::CameraFrame>(ev.payload);
     if (!frame.pixels || frame.pixels->size() != static_cast<size_t>(frame.width) * frame.height) return;
     const cv::Mat image(frame.height, frame.width, CV_8UC1, const_cast<uint8_t*>(frame.pixels->data()));
     const auto t0 = std::chrono::steady_clock::now();
-    const std::vector<vision::ObservedTag> tags = observer_.Observe(image);
+    const std::vector<vision::ObservedTag> tags = observer_->Observe(image);
     ms_.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     last_frame_ = frame.pixels;
     last_size_ = {frame.width, frame.height};
     last_tags_.clear();
     for (const vision::ObservedTag& t : tags) last_tags_.push_back(t.detection);
-    drivers::TagSightings out;
+    msgs::TagSightings out;
     for (const vision::ObservedTag& t : tags) {
       const auto& q = t.quaternion;
       out.tags.push_back({t.detection.id, t.camera.t[0], t.camera.t[1], t.camera.t[2], q[0], q[1], q[2], q[3]});
@@ -68,8 +69,8 @@ class TagSightingsStage : public Stage {
       csv_ << row;
     }
     ++frames_;
-    drivers::Event sightings;
-    sightings.kind = drivers::EventKind::kTagSightings;
+    msgs::Event sightings;
+    sightings.kind = msgs::EventKind::kTagSightings;
     sightings.channel = o_.channel;
     sightings.t_us = ev.t_us;
     sightings.stamp_us = ev.stamp_us;
@@ -83,26 +84,30 @@ class TagSightingsStage : public Stage {
     std::sort(sorted.begin(), sorted.end());
     const double median = sorted.empty() ? 0.0 : sorted[sorted.size() / 2];
     int64_t total = 0;
-    std::ostringstream j;
-    j << "{\n  \"camera\": " << JsonString(o_.camera_yaml) << ", \"channel\": " << JsonString(o_.channel)
-      << ", \"tag_size_m\": " << Num(o_.observer.tag_size_m) << ",\n  \"frames\": " << frames_ << ", \"per_id\": {";
-    bool first = true;
+    reports::Json per_id = reports::Json::object();
     for (const auto& [id, n] : per_id_) {
-      j << (first ? "" : ", ") << "\"" << id << "\": " << n, first = false;
+      per_id[std::to_string(id)] = n;
       total += n;
     }
-    j << "}, \"sightings\": " << total << ", \"ignored_ids\": " << observer_.ignored()
-      << ",\n  \"ms_per_frame\": {\"median\": " << Num(median)
-      << ", \"max\": " << Num(sorted.empty() ? 0 : sorted.back())
-      << "}, \"interrupted\": " << (interrupted ? "true" : "false") << "\n}\n";
-    WriteFileAtomically(ctx.output_dir + "/sightings.json", [&](std::ostream& out) { out << j.str(); });
+    reports::WriteJson(
+        ctx.output_dir + "/sightings.json",
+        {{"camera", o_.camera_yaml},
+         {"channel", o_.channel},
+         {"tag_size_m", reports::Number(o_.observer.tag_size_m)},
+         {"frames", frames_},
+         {"per_id", std::move(per_id)},
+         {"sightings", total},
+         {"ignored_ids", observer_->ignored()},
+         {"ms_per_frame",
+          {{"median", reports::Number(median)}, {"max", reports::Number(sorted.empty() ? 0 : sorted.back())}}},
+         {"interrupted", interrupted}});
     mbot::log::Info("tag_sightings: " + std::to_string(total) + " tags in " + std::to_string(frames_) + " frames on " +
-                    o_.channel + " (" + std::to_string(observer_.ignored()) + " of other ids ignored)");
+                    o_.channel + " (" + std::to_string(observer_->ignored()) + " of other ids ignored)");
   }
 
  private:
   // A lift (carrying begins) or a set-down (it ends): the last frame, with its tags drawn.
-  void ForkliftChanged(const drivers::ForkliftStatus& f) {
+  void ForkliftChanged(const msgs::ForkliftStatus& f) {
     const bool changed = f.carrying != carrying_;
     carrying_ = f.carrying;
     if (f.crate_id >= 0) crate_ = f.crate_id;
@@ -118,7 +123,7 @@ class TagSightingsStage : public Stage {
   }
 
   TagSightingsOptions o_;
-  vision::TagObserver observer_;
+  std::optional<vision::TagObserver> observer_;  // from Start
   Bus* bus_ = nullptr;
   std::ostringstream csv_;
   std::vector<double> ms_;
@@ -134,7 +139,7 @@ class TagSightingsStage : public Stage {
 
 }  // namespace
 
-StageType TagSightingsStageType() {
+static StageType TagSightingsStageType() {
   return {"tag_sightings",
           "camera frames → AprilTag poses in the camera and robot frames, emitted on MBOT_APRILTAG_ARRAY "
           "(kTagSightings); sightings.csv, sightings.json",
@@ -146,5 +151,7 @@ StageType TagSightingsStageType() {
             return std::make_unique<TagSightingsStage>(o);
           }};
 }
+
+const RegisterStage kTagSightingsRegistered{TagSightingsStageType()};
 
 }  // namespace mbot::app

@@ -14,7 +14,7 @@
 namespace mbot::app {
 namespace {
 
-using drivers::EventKind;
+using msgs::EventKind;
 
 struct TrajectoryWriterOptions {
   std::string odometry_file = "odometry.tum";
@@ -26,7 +26,7 @@ class TrajectoryWriterStage : public Stage {
  public:
   explicit TrajectoryWriterStage(TrajectoryWriterOptions o) : options_(std::move(o)) {}
 
-  void OnEvent(const drivers::Event& ev) override {
+  void OnEvent(const msgs::Event& ev) override {
     if (ev.kind != EventKind::kOdometry && ev.kind != EventKind::kGroundTruth && ev.kind != EventKind::kReferencePose) {
       return;
     }
@@ -36,7 +36,7 @@ class TrajectoryWriterStage : public Stage {
     if (track.channel.empty()) track.channel = ev.channel;
     if (track.channel != ev.channel) {
       mbot::log::WarnOnce("trajectory_writer:" + ev.channel,
-                          "trajectory_writer: " + std::string(drivers::ToString(ev.kind)) + " channel " + ev.channel +
+                          "trajectory_writer: " + std::string(msgs::ToString(ev.kind)) + " channel " + ev.channel +
                               " ignored; writing " + track.channel);
       return;
     }
@@ -52,7 +52,7 @@ class TrajectoryWriterStage : public Stage {
       if (name.empty()) continue;
       const std::string path = ctx.output_dir + "/" + name;
       WriteFileAtomically(path, [&](std::ostream& o) {
-        o << "# " << drivers::ToString(kind) << " from channel " << track.channel << ": t x y z qx qy qz qw\n"
+        o << "# " << msgs::ToString(kind) << " from channel " << track.channel << ": t x y z qx qy qz qw\n"
           << track.text;
       });
       mbot::log::Info("wrote " + path);
@@ -70,7 +70,7 @@ class TrajectoryWriterStage : public Stage {
 
 }  // namespace
 
-StageType TrajectoryWriterStageType() {
+static StageType TrajectoryWriterStageType() {
   return {"trajectory_writer", "writes the odometry, ground-truth and reference pose channels as TUM trajectories",
           [](config::Section& s) -> std::unique_ptr<Stage> {
             TrajectoryWriterOptions o;
@@ -83,5 +83,7 @@ StageType TrajectoryWriterStageType() {
             return std::make_unique<TrajectoryWriterStage>(o);
           }};
 }
+
+const RegisterStage kTrajectoryWriterRegistered{TrajectoryWriterStageType()};
 
 }  // namespace mbot::app

@@ -210,7 +210,10 @@ const Entry* Section::Find(const std::string& key, const std::string& type, cons
                            const std::string& doc) {
   known_.push_back(key);
   if (describing()) {
-    docs_.push_back(KeyDoc{key, type, def, required, doc});
+    // Documented once: source types that share a key (the channel roles) each read it.
+    if (std::none_of(docs_.begin(), docs_.end(), [&](const KeyDoc& d) { return d.key == key; })) {
+      docs_.push_back(KeyDoc{key, type, def, required, doc});
+    }
     return nullptr;
   }
   auto it = entries_->find(key);

@@ -13,6 +13,8 @@
 #include "mbot/common/log.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 namespace {
 
 namespace fs = std::filesystem;
@@ -63,17 +65,24 @@ struct CameraSource::Impl {
   std::string ended;  // why a device's stream ended, for the summary
 
   Event Frame(const cv::Mat& image, int64_t t_us, const std::string& name) {
-    cv::Mat grey;
+    cv::Mat out;  // grey, or BGR when asked for colour and the image has it
     if (image.channels() == 1) {
-      grey = image;
+      out = image;
+    } else if (o.color) {
+      if (image.channels() == 4) {
+        cv::cvtColor(image, out, cv::COLOR_BGRA2BGR);
+      } else {
+        out = image;
+      }
     } else {
-      cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
+      cv::cvtColor(image, out, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
     }
-    if (grey.depth() != CV_8U) grey.convertTo(grey, CV_8U);
+    if (out.depth() != CV_8U) out.convertTo(out, CV_8U);
     CameraFrame f;
-    f.width = grey.cols, f.height = grey.rows, f.name = name;
-    auto pixels = std::make_shared<std::vector<uint8_t>>(static_cast<size_t>(grey.cols) * grey.rows);
-    for (int y = 0; y < grey.rows; ++y) std::copy_n(grey.ptr<uint8_t>(y), grey.cols, pixels->data() + y * grey.cols);
+    f.width = out.cols, f.height = out.rows, f.name = name, f.channels = out.channels();
+    const size_t row = static_cast<size_t>(out.cols) * out.channels();
+    auto pixels = std::make_shared<std::vector<uint8_t>>(row * out.rows);
+    for (int y = 0; y < out.rows; ++y) std::copy_n(out.ptr<uint8_t>(y), row, pixels->data() + y * row);
     f.pixels = std::move(pixels);
     Event ev;
     ev.kind = EventKind::kCameraFrame;
@@ -88,7 +97,7 @@ struct CameraSource::Impl {
 
 CameraSource::CameraSource(const SourceOptions& options) : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
-  m.o = options.camera;
+  m.o = ExtraOr<CameraSourceOptions>(options);
   m.path = options.path;
   std::error_code ec;
   if (fs::is_directory(m.path, ec)) {

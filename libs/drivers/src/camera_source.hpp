@@ -9,10 +9,12 @@
 #include <string>
 #include <vector>
 
-#include "mbot/drivers/source.hpp"
+#include "mbot/msgs/source.hpp"
 #include "mbot/drivers/source_options.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 
 class CameraSource : public Source {
  public:

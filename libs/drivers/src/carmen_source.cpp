@@ -12,6 +12,8 @@
 #include "mbot/common/log.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 namespace {
 
 // Splits on whitespace.
@@ -100,7 +102,8 @@ void CarmenSource::GuessBeamGeometry(int n, double* start, double* inc) {
   *start = -fov / 2.0;
 }
 
-CarmenSource::CarmenSource(const SourceOptions& options) : options_(options), max_range_m_(options.carmen_max_range_m) {
+CarmenSource::CarmenSource(const SourceOptions& options)
+    : options_(options), carmen_(ExtraOr<CarmenOptions>(options)), max_range_m_(carmen_.max_range_m) {
   gzFile f = gzopen(options.path.c_str(), "rb");
   if (!f) throw std::runtime_error(options.path + ": cannot open CARMEN log");
   std::string line;
@@ -134,7 +137,7 @@ CarmenSource::CarmenSource(const SourceOptions& options) : options_(options), ma
     diagnostics_.truncated_tail = true;
   }
   gzclose(f);
-  if (options.carmen_file_order) {
+  if (carmen_.file_order) {
     // File order: a record's event time is its stamp, or just after the record before when the stamp
     // runs backwards; the records of one line share it.
     int64_t last = INT64_MIN;
@@ -197,8 +200,8 @@ void CarmenSource::ParseLine(const std::string& line, int line_no) {
         scan.angles_rad[i] = static_cast<float>(start + i * inc);
       }
       scan.max_range_m = static_cast<float>(max_range_m_);
-      const motion::Pose2D pose{c.Num("x"), c.Num("y"), c.Num("theta")};
-      const motion::Pose2D odom{c.Num("odom_x"), c.Num("odom_y"), c.Num("odom_theta")};
+      const msgs::Pose2D pose{c.Num("x"), c.Num("y"), c.Num("theta")};
+      const msgs::Pose2D odom{c.Num("odom_x"), c.Num("odom_y"), c.Num("odom_theta")};
       const int64_t ts = Micros(c.Num("ipc_timestamp"));
       c.End();
       // The laser pose (corrected in these logs) and the odometry fields stay apart.
@@ -209,14 +212,14 @@ void CarmenSource::ParseLine(const std::string& line, int line_no) {
       channel(name + ".pose", "laser pose fields", EventKind::kReferencePose);
       channel(name + ".odom", "odometry fields", EventKind::kOdometry);
     } else if (name == "ODOM") {
-      const motion::Pose2D pose{c.Num("x"), c.Num("y"), c.Num("theta")};
+      const msgs::Pose2D pose{c.Num("x"), c.Num("y"), c.Num("theta")};
       c.Skip(3);  // tv rv accel
       const int64_t ts = Micros(c.Num("ipc_timestamp"));
       c.End();
       events_.push_back(Event{ts, ts, name, EventKind::kOdometry, pose});
       channel(name, "ODOM", EventKind::kOdometry);
     } else if (name == "TRUEPOS") {
-      const motion::Pose2D truth{c.Num("true_x"), c.Num("true_y"), c.Num("true_theta")};
+      const msgs::Pose2D truth{c.Num("true_x"), c.Num("true_y"), c.Num("true_theta")};
       c.Skip(3);
       const int64_t ts = Micros(c.Num("ipc_timestamp"));
       c.End();
@@ -244,8 +247,8 @@ void CarmenSource::ParseLine(const std::string& line, int line_no) {
       scan.max_range_m = static_cast<float>(max_range);
       int64_t ts;
       if (robot) {
-        const motion::Pose2D laser{c.Num("laser_x"), c.Num("laser_y"), c.Num("laser_theta")};
-        const motion::Pose2D robot_pose{c.Num("robot_x"), c.Num("robot_y"), c.Num("robot_theta")};
+        const msgs::Pose2D laser{c.Num("laser_x"), c.Num("laser_y"), c.Num("laser_theta")};
+        const msgs::Pose2D robot_pose{c.Num("robot_x"), c.Num("robot_y"), c.Num("robot_theta")};
         c.Skip(5);  // tv rv forward_safety side_safety turn_axis
         ts = Micros(c.Num("timestamp"));
         c.End();
@@ -262,7 +265,7 @@ void CarmenSource::ParseLine(const std::string& line, int line_no) {
     } else if (name == "PARAM") {
       if (t.size() >= 3 && t[1] == "robot_front_laser_max") {
         max_range_m_ = std::strtod(t[2].c_str(), nullptr);
-        if (!(max_range_m_ > 0 && max_range_m_ <= 1e4)) max_range_m_ = options_.carmen_max_range_m;
+        if (!(max_range_m_ > 0 && max_range_m_ <= 1e4)) max_range_m_ = carmen_.max_range_m;
       }
       ++ignored_lines_;
     } else {

@@ -7,10 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "mbot/drivers/source.hpp"
+#include "mbot/msgs/source.hpp"
 #include "mbot/drivers/source_options.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 
 class CarmenSource : public Source {
  public:
@@ -29,6 +31,7 @@ class CarmenSource : public Source {
   void ParseLine(const std::string& line, int line_no);
 
   SourceOptions options_;
+  CarmenOptions carmen_;
   std::vector<Event> events_;
   size_t next_ = 0;
   double max_range_m_;

@@ -23,13 +23,14 @@
 #include "mbot/common/files.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/common/strings.hpp"
-#include "mbot/mapping/log_odds_mapper.hpp"
+#include "mbot/msgs/scan_renderer.hpp"
 #include "mrpt_read.hpp"
 #include "mrpt_scan.hpp"
 
 namespace fs = std::filesystem;
 
 namespace mbot::drivers {
+
 namespace {
 
 std::string ShortestDouble(double v) {
@@ -93,7 +94,7 @@ void CheckImageHeader(const std::string& path) {
 
 }  // namespace
 
-mapping::OccupancyGrid ReadBotlabMap(const std::string& path) {
+msgs::OccupancyGrid ReadBotlabMap(const std::string& path) {
   std::ifstream in(path);
   if (!in) Fail(path, "cannot open map");
   double ox, oy, res;
@@ -102,7 +103,7 @@ mapping::OccupancyGrid ReadBotlabMap(const std::string& path) {
     Fail(path, "line 1: expected 'origin_x origin_y width height meters_per_cell'");
   CheckDeclaredCells(path, "line 1: width x height", w, h, 2.0);  // a value and a separator per cell
   CheckFrame(path, "line 1:", ox, oy, res);
-  mapping::OccupancyGrid grid(static_cast<int>(w), static_cast<int>(h), res, ox, oy);
+  msgs::OccupancyGrid grid(static_cast<int>(w), static_cast<int>(h), res, ox, oy);
   for (long long y = 0; y < h; ++y) {
     for (long long x = 0; x < w; ++x) {
       int v;
@@ -120,7 +121,7 @@ mapping::OccupancyGrid ReadBotlabMap(const std::string& path) {
   return grid;
 }
 
-void WriteBotlabMap(const mapping::OccupancyGrid& g, const std::string& path) {
+void WriteBotlabMap(const msgs::OccupancyGrid& g, const std::string& path) {
   WriteFileAtomically(path, [&](std::ostream& out) {
     out << ShortestDouble(g.origin_x()) << ' ' << ShortestDouble(g.origin_y()) << ' ' << g.width() << ' ' << g.height()
         << ' ' << ShortestDouble(g.resolution()) << '\n';
@@ -137,7 +138,7 @@ void WriteBotlabMap(const mapping::OccupancyGrid& g, const std::string& path) {
   });
 }
 
-mapping::OccupancyGrid ReadRosMap(const std::string& yaml_path) {
+msgs::OccupancyGrid ReadRosMap(const std::string& yaml_path) {
   std::ifstream in(yaml_path);
   if (!in) Fail(yaml_path, "cannot open map YAML");
   std::string image;
@@ -202,7 +203,7 @@ mapping::OccupancyGrid ReadRosMap(const std::string& yaml_path) {
   }
   if (img.empty()) Fail(img_path.string(), "cannot read map image (named in " + yaml_path + ")");
   CheckDeclaredCells(img_path.string(), "image width x height", img.cols, img.rows, 0.0);
-  mapping::OccupancyGrid grid(img.cols, img.rows, res, ox, oy);
+  msgs::OccupancyGrid grid(img.cols, img.rows, res, ox, oy);
   for (int r = 0; r < img.rows; ++r) {
     const uint8_t* row = img.ptr<uint8_t>(r);
     const int y = img.rows - 1 - r;
@@ -220,7 +221,7 @@ mapping::OccupancyGrid ReadRosMap(const std::string& yaml_path) {
   return grid;
 }
 
-void WriteRosMap(const mapping::OccupancyGrid& g, const std::string& yaml_path) {
+void WriteRosMap(const msgs::OccupancyGrid& g, const std::string& yaml_path) {
   const fs::path yaml(yaml_path);
   const fs::path pgm = fs::path(yaml).replace_extension(".pgm");
   cv::Mat img(g.height(), g.width(), CV_8UC1);
@@ -243,7 +244,7 @@ void WriteRosMap(const mapping::OccupancyGrid& g, const std::string& yaml_path) 
   });
 }
 
-mapping::OccupancyGrid ReadMrptGridmap(const std::string& path) {
+msgs::OccupancyGrid ReadMrptGridmap(const std::string& path) {
   mrpt::maps::COccupancyGridMap2D m;
   ReadMrptFile(path, "MRPT gridmap", [&] {
     mrpt::io::CFileGZInputStream f(path);
@@ -255,8 +256,8 @@ mapping::OccupancyGrid ReadMrptGridmap(const std::string& path) {
   });
   CheckDeclaredCells(path, "grid size_x x size_y", m.getSizeX(), m.getSizeY(), 0.0);
   CheckFrame(path, "grid", m.getXMin(), m.getYMin(), m.getResolution());
-  mapping::OccupancyGrid out(static_cast<int>(m.getSizeX()), static_cast<int>(m.getSizeY()), m.getResolution(),
-                             m.getXMin(), m.getYMin());
+  msgs::OccupancyGrid out(static_cast<int>(m.getSizeX()), static_cast<int>(m.getSizeY()), m.getResolution(),
+                          m.getXMin(), m.getYMin());
   for (int y = 0; y < out.height(); ++y) {
     for (int x = 0; x < out.width(); ++x) {
       const double p_occ = std::clamp(1.0 - double(m.getCell(x, y)), 1e-6, 1.0 - 1e-6);
@@ -266,54 +267,49 @@ mapping::OccupancyGrid ReadMrptGridmap(const std::string& path) {
   return out;
 }
 
-mapping::OccupancyGrid ReadMrptSimplemap(const std::string& path, double resolution_m) {
+msgs::OccupancyGrid ReadMrptSimplemap(const std::string& path, double resolution_m) {
   mrpt::maps::CSimpleMap sm;
   ReadMrptFile(path, "MRPT simplemap", [&] {
     if (!sm.loadFromFile(path)) Fail(path, "cannot read MRPT simplemap");
   });
-  mapping::MapperOptions options;
-  options.resolution_m = resolution_m;
-  for (size_t k = 0; k < sm.size(); ++k) {  // start the extent around the first keyframe
+  // The keyframes' scans, each at its keyframe's pose, rendered by libs/mapping (msgs::ScanRenderer).
+  std::vector<msgs::PosedScan> posed;
+  msgs::Pose2D centre;  // the grid starts around the first keyframe
+  for (size_t k = 0; k < sm.size(); ++k) {
     if (const auto pair = sm.getAsPair(k); pair.pose) {
-      options.center_x_m = pair.pose->getMeanVal().x();
-      options.center_y_m = pair.pose->getMeanVal().y();
+      centre = {pair.pose->getMeanVal().x(), pair.pose->getMeanVal().y(), 0};
       break;
     }
   }
-  mapping::LogOddsMapper mapper(options);
-  const mapping::ScanOptions scan_options;
-  size_t scans = 0;
   for (size_t k = 0; k < sm.size(); ++k) {
     const auto pair = sm.getAsPair(k);
     if (!pair.pose || !pair.sf) continue;
     const mrpt::poses::CPose3D mean = pair.pose->getMeanVal();
-    const motion::Pose2D robot{mean.x(), mean.y(), mean.yaw()};
+    const msgs::Pose2D robot{mean.x(), mean.y(), mean.yaw()};
     for (const auto& obs : *pair.sf) {
       auto mrpt_scan = std::dynamic_pointer_cast<mrpt::obs::CObservation2DRangeScan>(obs);
-      if (!mrpt_scan) continue;
-      const LidarScan scan = FromMrptScan(*mrpt_scan);
-      const std::vector<float> fractions(scan.ranges_m.size(), 1.0f);  // a keyframe's scan has one pose
-      mapper.Insert(mapping::DeskewScan(scan.ranges_m, scan.angles_rad, fractions, {}, scan.sensor_pose,
-                                        scan.max_range_m, scan_options),
-                    robot);
-      ++scans;
+      if (mrpt_scan) posed.push_back({robot, FromMrptScan(*mrpt_scan)});
     }
   }
+  const size_t scans = posed.size();
   if (scans == 0)
     Fail(path, "holds no 2D range scans to build a grid from (" + std::to_string(sm.size()) + " keyframes)");
-  if (mapper.rejected_scans() == static_cast<int>(scans)) {
+  const msgs::ScanRenderer* render = msgs::GetScanRenderer();
+  if (!render) Fail(path, "a simplemap is rendered by libs/mapping, whose renderer this program did not register");
+  msgs::RenderedGrid r = (*render)(posed, resolution_m, centre);
+  if (r.rejected_scans == static_cast<int>(scans)) {
     Fail(path, "none of its " + std::to_string(scans) + " scans could be inserted (non-finite poses or ranges " +
                    "that would grow the grid past " + std::to_string(kMaxMapCells) + " cells)");
   }
-  if (mapper.rejected_scans() > 0) {
-    mbot::log::Warn(path + ": " + std::to_string(mapper.rejected_scans()) + " of " + std::to_string(scans) +
+  if (r.rejected_scans > 0) {
+    mbot::log::Warn(path + ": " + std::to_string(r.rejected_scans) + " of " + std::to_string(scans) +
                     " scans left out (non-finite poses or ranges that would grow the grid past " +
                     std::to_string(kMaxMapCells) + " cells)");
   }
-  return mapper.map();
+  return std::move(r.grid);
 }
 
-mapping::OccupancyGrid ReadMovingAiMap(const std::string& path) {
+msgs::OccupancyGrid ReadMovingAiMap(const std::string& path) {
   std::ifstream in(path);
   if (!in) Fail(path, "cannot open map");
   std::string line, word;
@@ -334,7 +330,7 @@ mapping::OccupancyGrid ReadMovingAiMap(const std::string& path) {
   }
   if (w <= 0 || h <= 0) Fail(path, "missing width/height header");
   CheckDeclaredCells(path, "header width x height", w, h, 1.0);
-  mapping::OccupancyGrid grid(w, h, 1.0, 0.0, 0.0);
+  msgs::OccupancyGrid grid(w, h, 1.0, 0.0, 0.0);
   for (int r = 0; r < h; ++r) {
     if (!std::getline(in, line)) Fail(path, "ends after " + std::to_string(r) + " of " + std::to_string(h) + " rows");
     ++line_no;
@@ -351,7 +347,7 @@ mapping::OccupancyGrid ReadMovingAiMap(const std::string& path) {
   return grid;
 }
 
-void WriteMapPng(const mapping::OccupancyGrid& g, const std::string& path) {
+void WriteMapPng(const msgs::OccupancyGrid& g, const std::string& path) {
   cv::Mat img(g.height(), g.width(), CV_8UC1);
   for (int y = 0; y < g.height(); ++y) {
     uint8_t* row = img.ptr<uint8_t>(g.height() - 1 - y);
@@ -362,7 +358,7 @@ void WriteMapPng(const mapping::OccupancyGrid& g, const std::string& path) {
   CommitFile(tmp, path);
 }
 
-void WriteMapPngWithOverlays(const mapping::OccupancyGrid& g, const std::vector<MapOverlay>& overlays, int scale,
+void WriteMapPngWithOverlays(const msgs::OccupancyGrid& g, const std::vector<MapOverlay>& overlays, int scale,
                              const std::string& path) {
   scale = std::max(1, scale);
   cv::Mat gray(g.height(), g.width(), CV_8UC1);
@@ -373,7 +369,7 @@ void WriteMapPngWithOverlays(const mapping::OccupancyGrid& g, const std::vector<
   cv::Mat img;
   cv::cvtColor(gray, img, cv::COLOR_GRAY2BGR);
   if (scale > 1) cv::resize(img, img, cv::Size(), scale, scale, cv::INTER_NEAREST);
-  auto pixel = [&](const motion::Pose2D& p) {
+  auto pixel = [&](const msgs::Pose2D& p) {
     const double px = (p.x - g.origin_x()) / g.resolution() * scale;
     const double py = (g.height() - (p.y - g.origin_y()) / g.resolution()) * scale;
     return cv::Point(static_cast<int>(std::lround(px)), static_cast<int>(std::lround(py)));
@@ -382,11 +378,11 @@ void WriteMapPngWithOverlays(const mapping::OccupancyGrid& g, const std::vector<
   for (const MapOverlay& o : overlays) {
     const cv::Scalar colour(o.b, o.g, o.r);
     if (o.points) {
-      for (const motion::Pose2D& p : o.poses) cv::circle(img, pixel(p), 1, colour, cv::FILLED);
+      for (const msgs::Pose2D& p : o.poses) cv::circle(img, pixel(p), 1, colour, cv::FILLED);
     } else if (o.poses.size() > 1) {
       std::vector<cv::Point> line;
       line.reserve(o.poses.size());
-      for (const motion::Pose2D& p : o.poses) line.push_back(pixel(p));
+      for (const msgs::Pose2D& p : o.poses) line.push_back(pixel(p));
       cv::polylines(img, line, false, colour, 1, cv::LINE_AA);
     }
     if (!o.label.empty()) {
@@ -400,7 +396,7 @@ void WriteMapPngWithOverlays(const mapping::OccupancyGrid& g, const std::vector<
   CommitFile(tmp, path);
 }
 
-void WriteOctomap(const mapping::OccupancyGrid& g, double wall_height_m, const std::string& path) {
+void WriteOctomap(const msgs::OccupancyGrid& g, double wall_height_m, const std::string& path) {
   const double res = g.resolution();
   octomap::OcTree tree(res);
   const int layers = std::max(1, static_cast<int>(std::ceil(wall_height_m / res)));
@@ -430,7 +426,7 @@ bool IsMapFile(const std::string& path) {
   return false;
 }
 
-mapping::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format) {
+msgs::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format) {
   RequireReadableFile(path);
   auto set = [&](const char* f) {
     if (format) *format = f;
@@ -461,7 +457,7 @@ mapping::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format) 
   Fail(path, "not a known map format (.map, .yaml, .gridmap, .gridmap.gz, .simplemap, .simplemap.gz)");
 }
 
-void WriteSlamCheckpoint(const std::string& ini_path, const mapping::OccupancyGrid& map, const SlamCheckpoint& c) {
+void WriteSlamCheckpoint(const std::string& ini_path, const msgs::OccupancyGrid& map, const SlamCheckpoint& c) {
   const fs::path ini(ini_path);
   const fs::path map_path = fs::path(ini).replace_extension(".map");
   WriteBotlabMap(map, map_path.string());

@@ -10,6 +10,8 @@
 #include "mbot/common/strings.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 namespace {
 
 std::string Lower(std::string s) {

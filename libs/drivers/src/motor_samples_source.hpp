@@ -7,9 +7,11 @@
 #include <string>
 #include <vector>
 
-#include "mbot/drivers/source.hpp"
+#include "mbot/msgs/source.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 
 // True when the file's first non-comment line is the header or three numbers.
 bool IsMotorSamplesFile(const std::string& path);

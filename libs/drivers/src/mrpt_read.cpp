@@ -27,6 +27,7 @@
 #endif
 
 namespace mbot::drivers {
+
 namespace {
 
 // Child side: a crash or an allocation failure ends the child quietly (the parent reports it), and

@@ -5,9 +5,11 @@
 
 #include <mrpt/obs/CObservation2DRangeScan.h>
 
-#include "mbot/drivers/events.hpp"
+#include "mbot/msgs/events.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 
 inline LidarScan FromMrptScan(const mrpt::obs::CObservation2DRangeScan& scan) {
   LidarScan s;

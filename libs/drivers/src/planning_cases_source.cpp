@@ -10,6 +10,8 @@
 #include "mbot/drivers/map_io.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 namespace fs = std::filesystem;
 namespace {
 
@@ -23,7 +25,7 @@ void ReadBotlabCases(const std::string& poses_path, std::vector<Event>* out) {
   const std::string name = stem.substr(0, stem.size() - std::string("_poses.txt").size());
   const std::string map_path = (fs::path(poses_path).parent_path() / (name + ".map")).string();
   if (!fs::is_regular_file(map_path)) Fail(poses_path, 0, "its map " + map_path + " does not exist");
-  auto grid = std::make_shared<const mapping::OccupancyGrid>(ReadBotlabMap(map_path));
+  auto grid = std::make_shared<const msgs::OccupancyGrid>(ReadBotlabMap(map_path));
   out->push_back(Event{0, 0, name, EventKind::kMap, grid});
   std::ifstream in(poses_path);
   if (!in) Fail(poses_path, 0, "cannot open");
@@ -63,7 +65,7 @@ void ReadMovingAiScenarios(const std::string& scen_path, std::vector<Event>* out
   if (!in) Fail(scen_path, 0, "cannot open");
   std::string line, map_rel;
   int line_no = 0;
-  std::shared_ptr<const mapping::OccupancyGrid> grid;
+  std::shared_ptr<const msgs::OccupancyGrid> grid;
   std::string channel;
   int index = 0;
   while (std::getline(in, line)) {
@@ -92,7 +94,7 @@ void ReadMovingAiScenarios(const std::string& scen_path, std::vector<Event>* out
         if (!found.empty() || d == d.parent_path() || d.empty()) break;
       }
       if (found.empty()) Fail(scen_path, line_no, "map '" + map_name + "' not found beside the file or above it");
-      grid = std::make_shared<const mapping::OccupancyGrid>(ReadMovingAiMap(found));
+      grid = std::make_shared<const msgs::OccupancyGrid>(ReadMovingAiMap(found));
       map_rel = map_name;
       channel = fs::path(map_name).filename().string();
       out->push_back(Event{0, 0, channel, EventKind::kMap, grid});
@@ -108,8 +110,8 @@ void ReadMovingAiScenarios(const std::string& scen_path, std::vector<Event>* out
       if (x < 0 || y < 0 || x >= w || y >= h) Fail(scen_path, line_no, "a position lies outside the map");
     }
     // Moving AI row y is grid row h - 1 - y (ReadMovingAiMap keeps +y up); 1 m cells.
-    r.start = motion::Pose2D{sx + 0.5, (h - 1 - sy) + 0.5, 0.0};
-    r.goal = motion::Pose2D{gx + 0.5, (h - 1 - gy) + 0.5, 0.0};
+    r.start = msgs::Pose2D{sx + 0.5, (h - 1 - sy) + 0.5, 0.0};
+    r.goal = msgs::Pose2D{gx + 0.5, (h - 1 - gy) + 0.5, 0.0};
     r.index = index++;
     out->push_back(Event{0, 0, channel, EventKind::kPlanRequest, r});
   }

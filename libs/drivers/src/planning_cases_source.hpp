@@ -6,9 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "mbot/drivers/source.hpp"
+#include "mbot/msgs/source.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 
 // True for a botlab poses file, a folder holding some, or a Moving AI scenario file.
 bool IsPlanningCasesPath(const std::string& path, std::string* format = nullptr);

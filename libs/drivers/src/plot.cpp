@@ -11,6 +11,7 @@
 #include "mbot/common/atomic_file.hpp"
 
 namespace mbot::drivers {
+
 namespace {
 
 // A "nice" tick step (1, 2 or 5 × 10^k) giving about `target` ticks over `span`.

@@ -20,6 +20,8 @@
 #include "mrpt_scan.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 namespace {
 
 // The rawlog's entries, as MRPT's CRawlog::loadFromRawLogFile reads them (one CRawlog object, or a
@@ -104,7 +106,7 @@ RawlogSource::RawlogSource(const SourceOptions& options) {
   }
   if (rawlog.size() == 0) mbot::log::Warn(options.path + ": the rawlog holds no entries");
 
-  motion::Pose2D odom;  // integrated from the actions of the Actions/SensoryFrame format
+  msgs::Pose2D odom;  // integrated from the actions of the Actions/SensoryFrame format
   // Entries without a timestamp are marked INT64_MIN and filled in below.
   auto stamp = [&](int64_t t) {
     if (t == INT64_MIN) ++invalid_stamps_;
@@ -122,7 +124,7 @@ RawlogSource::RawlogSource(const SourceOptions& options) {
       ev.payload = FromMrptScan(*scan);
     } else if (auto od = std::dynamic_pointer_cast<mrpt::obs::CObservationOdometry>(obs)) {
       ev.kind = EventKind::kOdometry;
-      ev.payload = motion::Pose2D{od->odometry.x(), od->odometry.y(), od->odometry.phi()};
+      ev.payload = msgs::Pose2D{od->odometry.x(), od->odometry.y(), od->odometry.phi()};
       if (od->hasEncodersInfo) {
         Event enc = ev;
         enc.kind = EventKind::kEncoders;

@@ -5,10 +5,12 @@
 #include <optional>
 #include <string>
 
-#include "mbot/drivers/source.hpp"
+#include "mbot/msgs/source.hpp"
 #include "mbot/drivers/source_options.hpp"
 
 namespace mbot::drivers {
+
+using namespace msgs;  // the event vocabulary
 
 class RawlogSource : public Source {
  public:

@@ -6,27 +6,6 @@
 
 namespace mbot::mapping {
 
-const char* ToString(SlamMode mode) {
-  switch (mode) {
-    case SlamMode::kMappingOnly: return "mapping-only";
-    case SlamMode::kActionOnly: return "action-only";
-    case SlamMode::kLocalization: return "localization";
-    case SlamMode::kFullSlam: return "full SLAM";
-    case SlamMode::kGraphSlam: return "graph SLAM";
-  }
-  return "?";
-}
-
-const char* ToString(SlamState state) {
-  switch (state) {
-    case SlamState::kMapping: return "mapping";
-    case SlamState::kLocalizing: return "localizing";
-    case SlamState::kLocalized: return "localized";
-    case SlamState::kLost: return "lost";
-  }
-  return "?";
-}
-
 SlamState StateOf(SlamMode mode, const FilterStatus& status) {
   if (mode != SlamMode::kLocalization) return SlamState::kMapping;
   return !status.converged ? SlamState::kLocalizing : status.lost ? SlamState::kLost : SlamState::kLocalized;
@@ -106,7 +85,7 @@ SlamStep Slam::ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2
   }
   // The filter moves only once odometry moved enough; in between the pose follows odometry.
   const bool moved = action_.Moved(last_odometry_, odometry) || !filter_.status().converged;
-  if (moved) {
+  if (moved && localization_on_) {
     const bool weigh = options_.mode == SlamMode::kLocalization || options_.mode == SlamMode::kFullSlam;
     if (weigh && sensor_stale_) {
       sensor_.SetMap(mapper_.map());
@@ -122,11 +101,35 @@ SlamStep Slam::ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2
   }
   out.status = filter_.status();
   out.pose = last_estimate_.Compose(last_odometry_.Inverse().Compose(odometry));
-  if (options_.mode != SlamMode::kLocalization) {
+  if (options_.mode != SlamMode::kLocalization && mapping_on_) {
     mapper_.Insert(rays, out.pose);
     sensor_stale_ = true;
   }
   return out;
+}
+
+void Slam::SetMapping(bool on) {
+  if (graph_) throw std::invalid_argument("graph SLAM maps every scan: its mapping cannot be switched");
+  if (options_.mode == SlamMode::kLocalization && on) {
+    throw std::invalid_argument("localization keeps its known map: it does not map");
+  }
+  mapping_on_ = on;
+}
+
+void Slam::SetLocalization(bool on) {
+  if (graph_) throw std::invalid_argument("graph SLAM matches every scan: its localization cannot be switched");
+  if (options_.mode == SlamMode::kMappingOnly) {
+    throw std::invalid_argument("mapping-only SLAM takes its poses from a reference: it does not localize");
+  }
+  localization_on_ = on;
+}
+
+void Slam::ClearMap() {
+  if (graph_) throw std::invalid_argument("graph SLAM's map is its graph's: it cannot be cleared");
+  if (options_.mode == SlamMode::kLocalization) throw std::invalid_argument("localization keeps its known map");
+  const OccupancyGrid& m = mapper_.map();
+  mapper_.Reset(OccupancyGrid(m.width(), m.height(), m.resolution(), m.origin_x(), m.origin_y(), 0));
+  sensor_stale_ = true;
 }
 
 void Slam::Finish() {

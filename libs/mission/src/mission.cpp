@@ -103,6 +103,8 @@ std::vector<MissionOutput> Mission::OnOdometry(int64_t t_us, const Pose2D& raw_o
     ++stale_stops_;
     SetState(status_.state, "SLAM pose stale: stopped");
     Hold();
+  } else if (manual_) {
+    ManualStep(pose, dt);
   } else if ((status_.state == MissionState::kCompleted || status_.state == MissionState::kIncomplete) &&
              exploring_first_) {
     exploring_first_ = false;  // explored and home: now the task, on the map just made
@@ -246,6 +248,73 @@ void Mission::SetGoal(const Pose2D& goal) {
 }
 
 void Mission::Hold() { Send(0, 0); }
+
+void Mission::ShowExploration(ExplorationOut seen) {
+  if (out_) out_->emplace_back(std::in_place_type<ExplorationOut>, std::move(seen));
+}
+
+void Mission::OnGoal(const Pose2D& goal) {
+  manual_ = true;
+  person_goal_ = goal;
+  teleop_until_us_ = -1;
+}
+
+void Mission::OnTeleop(int64_t t_us, double v_m_s, double w_rad_s) {
+  manual_ = true;
+  person_goal_.reset();
+  final_leg_ = false;
+  const double v_max = o_.controller.max_speed_m_s, w_max = o_.controller.max_turn_rate_rad_s;
+  teleop_ = {std::clamp(v_m_s, -v_max, v_max), std::clamp(w_rad_s, -w_max, w_max)};
+  teleop_until_us_ = t_us + static_cast<int64_t>(o_.teleop_timeout_s * 1e6);
+}
+
+// A person's goal or teleop, instead of the task.
+bool Mission::ManualStep(const Pose2D& pose, double dt) {
+  if (teleop_until_us_ >= 0) {
+    if (t_us_ <= teleop_until_us_) {
+      SetState(MissionState::kDriving,
+               "teleop: v " + Significant(teleop_.v_m_s, 3) + " m/s, w " + Significant(teleop_.w_rad_s, 3) + " rad/s");
+      Send(teleop_.v_m_s, teleop_.w_rad_s);
+      return true;
+    }
+    teleop_until_us_ = -1;  // the commands stopped coming: stop
+    SetState(MissionState::kWaiting, "teleop ended: holding for a goal or teleop");
+  }
+  if (person_goal_) {
+    if (!map_) {
+      SetState(MissionState::kWaiting, "a goal was set, but there is no map to plan on yet");
+      Hold();
+      return false;
+    }
+    planning::AStarPlanner planner(o_.exploration.astar);
+    planner.SetMap(planning::ObstacleDistanceGrid(*map_, o_.exploration.distance));
+    const planning::PlanResult r = planner.PlanSteppingOut(pose, *person_goal_);
+    const Pose2D goal = *person_goal_;
+    person_goal_.reset();
+    const std::string where = "(" + Significant(goal.x, 3) + ", " + Significant(goal.y, 3) + ")";
+    if (r.status != planning::PlanStatus::kFound) {
+      SetState(MissionState::kWaiting, "no path to the goal " + where + ": " + planning::ToString(r.status));
+      Hold();
+      return false;
+    }
+    SetGoal({goal.x, goal.y, r.path.back().theta});
+    SetPath(r.path);
+    SetState(MissionState::kDriving, "to the goal a person set " + where);
+  }
+  if (!final_leg_ || Recovering()) {
+    if (!final_leg_) Hold();
+    return false;
+  }
+  const motion::VelocityCommand c = controller_.Update(Predict(pose), dt);
+  Send(c.v_m_s, c.w_rad_s);
+  last_command_ = c;
+  std::string how;
+  if (controller_.arrived() && Settled(pose, &how)) {
+    EndFinalLeg();
+    SetState(MissionState::kArrived, "at the goal a person set (" + how + ")");
+  }
+  return true;
+}
 
 void Mission::Send(double v, double w) {
   ++commands_;

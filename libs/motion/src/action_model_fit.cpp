@@ -4,6 +4,7 @@
 #include <ceres/gradient_problem.h>
 #include <ceres/gradient_problem_solver.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -148,6 +149,22 @@ ActionModelFit FitActionModel(const std::vector<Pose2D>& odometry, const std::ve
   if (translating > 0 && fit.k2 < kAtZero)
     AddNote(&fit.message, "k2 ~ 0: translation errors lie within the noise floor");
   return fit;
+}
+
+double PlaceOnStamps(std::vector<TimedPose>* series, const std::vector<int64_t>& stamps) {
+  if (stamps.empty() || stamps.size() != series->size()) return -1;
+  for (int64_t s : stamps) {
+    if (s <= 0) return -1;  // a source without stamps: keep the event times
+  }
+  int64_t offset = std::numeric_limits<int64_t>::max();
+  for (size_t i = 0; i < series->size(); ++i) offset = std::min(offset, (*series)[i].t_us - stamps[i]);
+  double max_delay = 0;
+  for (size_t i = 0; i < series->size(); ++i) {
+    max_delay = std::max(max_delay, ((*series)[i].t_us - stamps[i] - offset) * 1e-6);
+    (*series)[i].t_us = stamps[i] + offset;
+  }
+  std::sort(series->begin(), series->end(), [](const TimedPose& a, const TimedPose& b) { return a.t_us < b.t_us; });
+  return max_delay;
 }
 
 }  // namespace mbot::motion

@@ -61,10 +61,27 @@ int PosePoints(const PoseError& e) {
 
 int LapPoints(double s) { return s < 15 ? 100 : s < 20 ? 75 : s < 30 ? 50 : 0; }
 
-MapQuality Quality(const World& world, const mapping::OccupancyGrid& m, const Pose2D& start) {
-  MapQuality q;
+ReachableCells FindReachableCells(const World& world, const Pose2D& start) {
+  ReachableCells r;
+  r.start = start;
   const mapping::OccupancyGrid& truth = world.truth();
   const std::vector<uint8_t> reach = ReachableFreeMask(world, start);
+  for (int cy = 0; cy < truth.height(); ++cy) {
+    for (int cx = 0; cx < truth.width(); ++cx) {
+      if (!reach[static_cast<size_t>(cy) * truth.width() + cx]) continue;
+      double x, y;
+      truth.CellToWorld(cx, cy, &x, &y);
+      r.x.push_back(x);
+      r.y.push_back(y);
+      r.clearance.push_back(world.ClearanceAt(x, y));
+    }
+  }
+  return r;
+}
+
+MapQuality Quality(const World& world, const mapping::OccupancyGrid& m, const ReachableCells& reachable) {
+  MapQuality q;
+  const Pose2D& start = reachable.start;
   const Pose2D inv = start.Inverse();
   // The free space that must be mapped keeps 1.5 map cells from the walls, the tolerance the wall
   // check below gives: a wall mapped up to 1.5 cells off counts as right, so the space it may cover
@@ -73,26 +90,21 @@ MapQuality Quality(const World& world, const mapping::OccupancyGrid& m, const Po
   // lidar noise those cells are saturated walls, which one cell of tolerance alone scored as missed.)
   // The share at one cell is kept beside it.
   int mapped = 0, counted_strict = 0, mapped_strict = 0;
-  for (int cy = 0; cy < truth.height(); ++cy) {
-    for (int cx = 0; cx < truth.width(); ++cx) {
-      if (!reach[static_cast<size_t>(cy) * truth.width() + cx]) continue;
-      double x, y;
-      truth.CellToWorld(cx, cy, &x, &y);
-      const double clearance = world.ClearanceAt(x, y);
-      if (clearance < m.resolution()) continue;
-      const Pose2D p = inv.Compose(Pose2D{x, y, 0});
-      int mx, my;
-      m.WorldToCell(p.x, p.y, &mx, &my);
-      const bool free = m.IsInside(mx, my) && m.at(mx, my) < 0;
-      ++counted_strict;
-      mapped_strict += free;
-      if (clearance < 1.5 * m.resolution()) continue;
-      ++q.reachable_cells;
-      if (free) {
-        ++mapped;
-      } else {
-        q.unmapped.push_back(p);
-      }
+  for (size_t i = 0; i < reachable.x.size(); ++i) {
+    const double clearance = reachable.clearance[i];
+    if (clearance < m.resolution()) continue;
+    const Pose2D p = inv.Compose(Pose2D{reachable.x[i], reachable.y[i], 0});
+    int mx, my;
+    m.WorldToCell(p.x, p.y, &mx, &my);
+    const bool free = m.IsInside(mx, my) && m.at(mx, my) < 0;
+    ++counted_strict;
+    mapped_strict += free;
+    if (clearance < 1.5 * m.resolution()) continue;
+    ++q.reachable_cells;
+    if (free) {
+      ++mapped;
+    } else {
+      q.unmapped.push_back(p);
     }
   }
   q.coverage = q.reachable_cells ? double(mapped) / q.reachable_cells : 0.0;
@@ -211,7 +223,7 @@ Score Referee::Judge() const {
     for (const auto& [id, on] : stacks) {
       CrateResult r{id, on, false, false, false, {}, 0.0};
       bool seen = false;
-      for (const drivers::CrateState& c : crates_.crates) {
+      for (const msgs::CrateState& c : crates_.crates) {
         if (c.id != id) continue;
         seen = true;
         r.lifted = c.lifted, r.fell = c.fell, r.final_pose = c.pose, r.final_z_m = c.z_m;
@@ -238,7 +250,11 @@ Score Referee::Judge() const {
     const bool home = s.completed || s.incomplete;
     s.items.push_back(
         {"final pose", Errors(e) + " from the start" + (home ? "" : " (not completed)"), home ? PosePoints(e) : 0});
-    const MapQuality mq = map_ ? Quality(world_, *map_, s.start) : MapQuality{};
+    if (map_ && (!reachable_ || reachable_->start.x != s.start.x || reachable_->start.y != s.start.y ||
+                 reachable_->start.theta != s.start.theta)) {
+      reachable_ = FindReachableCells(world_, s.start);
+    }
+    const MapQuality mq = map_ ? Quality(world_, *map_, *reachable_) : MapQuality{};
     s.map = mq;
     s.items.push_back(
         {"map quality",

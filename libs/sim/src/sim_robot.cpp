@@ -8,12 +8,12 @@
 
 namespace mbot::sim {
 
-using drivers::EncoderTicks;
-using drivers::Imu;
-using drivers::LidarScan;
-using drivers::MotorCommand;
-using drivers::Payload;
-using drivers::WheelSpeeds;
+using msgs::EncoderTicks;
+using msgs::Imu;
+using msgs::LidarScan;
+using msgs::MotorCommand;
+using msgs::Payload;
+using msgs::WheelSpeeds;
 namespace {
 
 using motion::Pose2D;
@@ -195,7 +195,7 @@ struct SimRobot::Impl {
       if (hit && !contact) {
         contact = true;
         ++collisions;
-        out->push_back(MakeEvent(t1, sim_channel::kCollision, EventKind::kCollision, pose));
+        out->push_back(MakeEvent(t1, topics::kCollision, EventKind::kCollision, pose));
       }
     } else {
       w_l = wl;
@@ -213,20 +213,20 @@ struct SimRobot::Impl {
     if (fork && fork->Step(h, pose)) crates_changed = true;
   }
 
-  drivers::CrateStates Crates() const {
-    drivers::CrateStates all;
+  msgs::CrateStates Crates() const {
+    msgs::CrateStates all;
     for (const Crate& c : world.crates())
       all.crates.push_back({c.id, c.pose, c.z_m, c.carried, c.on_id, c.fell, c.lifted});
     return all;
   }
 
   void PublishForkliftStatus(std::vector<Event>* out) {
-    drivers::ForkliftStatus st;
+    msgs::ForkliftStatus st;
     st.height_m = fork->height_m();
     st.target_m = fork->target_m();
     st.crate_id = fork->engaged() >= 0 ? world.crates()[fork->engaged()].id : -1;
     st.carrying = fork->carrying();
-    out->push_back(MakeEvent(now, sim_channel::kForkliftStatus, EventKind::kForkliftStatus, st));
+    out->push_back(MakeEvent(now, topics::kForkliftStatus, EventKind::kForkliftStatus, st));
   }
 
   // Beams whose time has come by t1, each cast from the pose interpolated at its own time.
@@ -265,7 +265,7 @@ struct SimRobot::Impl {
     imu.has_angles = true;
     imu_last_v = body_v;
     odometry.AddImu(now, rate, imu_yaw, true);
-    out->push_back(MakeEvent(now, sim_channel::kImu, EventKind::kImu, imu));
+    out->push_back(MakeEvent(now, topics::kImu, EventKind::kImu, imu));
   }
 
   // The Pico's control period: read the encoders, publish, update the odometry, run the wheel
@@ -279,9 +279,9 @@ struct SimRobot::Impl {
     // The firmware's wheel speeds, in each wheel's forward frame (what its controller works in).
     const double dt = fw_us * 1e-6;
     const double wl = pl * dl * rad_per_tick / dt, wr = pr * dr * rad_per_tick / dt;
-    out->push_back(MakeEvent(now, sim_channel::kEncoders, EventKind::kEncoders, EncoderTicks{tl, tr, dl, dr, fw_us}));
-    out->push_back(MakeEvent(now, sim_channel::kMotorVel, EventKind::kWheelSpeed, WheelSpeeds{wl, wr}));
-    out->push_back(MakeEvent(now, sim_channel::kOdometry, EventKind::kOdometry, odometry.AddEncoders(now, tl, tr)));
+    out->push_back(MakeEvent(now, topics::kEncoders, EventKind::kEncoders, EncoderTicks{tl, tr, dl, dr, fw_us}));
+    out->push_back(MakeEvent(now, topics::kMotorVelocity, EventKind::kWheelSpeed, WheelSpeeds{wl, wr}));
+    out->push_back(MakeEvent(now, topics::kOdometry, EventKind::kOdometry, odometry.AddEncoders(now, tl, tr)));
     // Like the MBot firmware, the robot stops when no velocity command came for the timeout (an
     // autonomy that died or a link that went quiet does not leave it driving).
     if (o.command_timeout_s > 0 && now - last_command_us > static_cast<int64_t>(o.command_timeout_s * 1e6)) {
@@ -290,7 +290,7 @@ struct SimRobot::Impl {
     const motion::WheelDuties duties = controller.Update(cmd_v, cmd_w, wl, wr);
     duty_l = duties.left;
     duty_r = duties.right;
-    out->push_back(MakeEvent(now, sim_channel::kMotorPwm, EventKind::kMotorCommand, MotorCommand::Pwm(duty_l, duty_r)));
+    out->push_back(MakeEvent(now, topics::kMotorPwm, EventKind::kMotorCommand, MotorCommand::Pwm(duty_l, duty_r)));
   }
 
   void AdvanceTo(int64_t t_end, std::vector<Event>* out) {
@@ -303,7 +303,7 @@ struct SimRobot::Impl {
       now = t1;
       CastBeams(t0, p0, t1, pose);
       if (now == next_rev_end) {
-        out->push_back(MakeEvent(now, sim_channel::kLidar, EventKind::kLidar, std::move(scan)));
+        out->push_back(MakeEvent(now, topics::kLidar, EventKind::kLidar, std::move(scan)));
         StartRevolution(now);
         next_rev_end += lidar_us;
         CastBeams(now, pose, now, pose);
@@ -317,7 +317,7 @@ struct SimRobot::Impl {
         next_fw += fw_us;
       }
       if (now == next_gt) {
-        out->push_back(MakeEvent(now, sim_channel::kTruePose, EventKind::kGroundTruth, pose));
+        out->push_back(MakeEvent(now, topics::kTruePose, EventKind::kGroundTruth, pose));
         next_gt += gt_us;
       }
       if (now == next_slip) {
@@ -326,16 +326,16 @@ struct SimRobot::Impl {
       }
       if (now == next_camera) {
         const cv::Mat image = camera->Render(world, pose, camera_rng);
-        drivers::CameraFrame frame;
+        msgs::CameraFrame frame;
         frame.width = image.cols, frame.height = image.rows;
         frame.pixels = std::make_shared<const std::vector<uint8_t>>(image.datastart, image.dataend);
         frame.name = "sim camera";
-        out->push_back(MakeEvent(now, sim_channel::kCamera, EventKind::kCameraFrame, std::move(frame)));
+        out->push_back(MakeEvent(now, topics::kCamera, EventKind::kCameraFrame, std::move(frame)));
         next_camera += camera_us;
       }
       if (fork && (crates_changed || now >= next_fork)) {
         if (crates_changed || next_fork == 0)
-          out->push_back(MakeEvent(now, sim_channel::kCrates, EventKind::kCrates, Crates()));
+          out->push_back(MakeEvent(now, topics::kCrates, EventKind::kCrates, Crates()));
         PublishForkliftStatus(out);
         if (now >= next_fork) next_fork = (now / fork_us + 1) * fork_us;
         crates_changed = false;

@@ -13,9 +13,9 @@
 namespace mbot::sim {
 namespace {
 
-using drivers::ChannelInfo;
-using drivers::MotorCommand;
-using drivers::SourceOptions;
+using msgs::ChannelInfo;
+using msgs::MotorCommand;
+using msgs::SourceOptions;
 
 motion::Pose2D StartPose(const SourceOptions& options, const SimSourceOptions& sim, const World& world) {
   if (sim.start) return *sim.start;
@@ -61,21 +61,20 @@ SimSource::SimSource(const SourceOptions& options, const SimSourceOptions& sim)
     }
   }
   const std::string gen = "simulated";
-  channels_[sim_channel::kEncoders] = ChannelInfo{"mbot_encoders_t", gen, EventKind::kEncoders, true};
-  channels_[sim_channel::kImu] = ChannelInfo{"mbot_imu_t", gen, EventKind::kImu, true};
-  channels_[sim_channel::kOdometry] = ChannelInfo{"pose2D_t", gen, EventKind::kOdometry, true};
-  channels_[sim_channel::kMotorPwm] = ChannelInfo{"mbot_motor_pwm_t", gen, EventKind::kMotorCommand, true};
-  channels_[sim_channel::kMotorVel] = ChannelInfo{"mbot_motor_vel_t", gen, EventKind::kWheelSpeed, true};
-  channels_[sim_channel::kLidar] = ChannelInfo{"lidar_t", gen, EventKind::kLidar, true};
-  channels_[sim_channel::kTruePose] = ChannelInfo{"pose2D_t", gen, EventKind::kGroundTruth, true};
-  channels_[sim_channel::kCollision] = ChannelInfo{"pose2D_t", gen, EventKind::kCollision, true};
+  channels_[topics::kEncoders] = ChannelInfo{"mbot_encoders_t", gen, EventKind::kEncoders, true};
+  channels_[topics::kImu] = ChannelInfo{"mbot_imu_t", gen, EventKind::kImu, true};
+  channels_[topics::kOdometry] = ChannelInfo{"pose2D_t", gen, EventKind::kOdometry, true};
+  channels_[topics::kMotorPwm] = ChannelInfo{"mbot_motor_pwm_t", gen, EventKind::kMotorCommand, true};
+  channels_[topics::kMotorVelocity] = ChannelInfo{"mbot_motor_vel_t", gen, EventKind::kWheelSpeed, true};
+  channels_[topics::kLidar] = ChannelInfo{"lidar_t", gen, EventKind::kLidar, true};
+  channels_[topics::kTruePose] = ChannelInfo{"pose2D_t", gen, EventKind::kGroundTruth, true};
+  channels_[topics::kCollision] = ChannelInfo{"pose2D_t", gen, EventKind::kCollision, true};
   if (sim.robot.forklift.enabled) {
-    channels_[sim_channel::kForkliftStatus] =
-        ChannelInfo{"mbot_forklift_status_t", gen, EventKind::kForkliftStatus, true};
-    channels_[sim_channel::kCrates] = ChannelInfo{"crate states", gen, EventKind::kCrates, true};
+    channels_[topics::kForkliftStatus] = ChannelInfo{"mbot_forklift_status_t", gen, EventKind::kForkliftStatus, true};
+    channels_[topics::kCrates] = ChannelInfo{"crate states", gen, EventKind::kCrates, true};
   }
   if (sim.robot.camera.enabled)
-    channels_[sim_channel::kCamera] = ChannelInfo{"8-bit grey image", gen, EventKind::kCameraFrame, true};
+    channels_[topics::kCamera] = ChannelInfo{"8-bit grey image", gen, EventKind::kCameraFrame, true};
 }
 
 std::optional<Event> SimSource::Next() {
@@ -121,7 +120,7 @@ std::vector<std::pair<std::string, std::string>> SimSource::Details() const {
 
 void SimSource::Send(const Event& event) {
   if (event.kind == EventKind::kForkliftCommand) {
-    const auto* cmd = std::get_if<drivers::ForkliftCommand>(&event.payload);
+    const auto* cmd = std::get_if<msgs::ForkliftCommand>(&event.payload);
     if (!cmd || !robot_->forklift()) return;
     const int before = robot_->forklift_commands_clamped();
     robot_->CommandFork(cmd->height_m);
@@ -138,14 +137,14 @@ void SimSource::Send(const Event& event) {
 }
 
 void RegisterSimSource() {
-  if (drivers::FindSourceType("sim")) return;
-  drivers::RegisterSourceType(
+  if (msgs::FindSourceType("sim")) return;
+  msgs::RegisterSourceType(
       {"sim",
        "the simulated MBot on a world (.arena, or a map whose unknown and occupied cells are walls); its keys "
        "are the simulator's",
        [](const std::string& path) { return EndsWith(path, ".arena"); }, 0,
        [](config::Section& s, SourceOptions* o) { o->extra = ParseSimSourceOptions(s, o->path); },
-       [](const SourceOptions& o) -> std::unique_ptr<drivers::Source> {
+       [](const SourceOptions& o) -> std::unique_ptr<msgs::Source> {
          const auto* sim = std::any_cast<SimSourceOptions>(&o.extra);
          return std::make_unique<SimSource>(o, sim ? *sim : SimSourceOptions{});
        }});

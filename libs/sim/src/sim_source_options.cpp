@@ -1,5 +1,7 @@
 #include "mbot/sim/sim_source_options.hpp"
 
+#include "mbot/msgs/topics.hpp"
+
 #include <string>
 #include <vector>
 
@@ -12,7 +14,7 @@ namespace mbot::sim {
 
 SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& world_path) {
   // Every key is documented as the simulator's: they exist only when the source is the simulator.
-  const auto doc = [](const char* text) { return std::string("simulator: ") + text; };
+  const auto doc = [](const std::string& text) { return std::string("simulator: ") + text; };
   SimSourceOptions o;
   const std::vector<std::string> start =
       s.GetList("start", {},
@@ -125,9 +127,11 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& wo
   if (f.engage_depth_m >= f.tine_length_m) s.Fail("fork_engage_depth_m", "must be below fork_tine_length_m");
 
   SimCameraOptions& c = r.camera;
-  c.enabled = s.GetBool("camera", c.enabled,
-                        doc("the robot has a camera: grey frames of the floor, walls and crates (with their tags) on "
-                            "CAMERA"));
+  c.enabled =
+      s.GetBool("camera", c.enabled,
+                doc(std::string("the robot has a camera: grey frames of the floor, walls and crates (with their "
+                                "tags) on ") +
+                    msgs::topics::kCamera));
   const std::string calibration = s.GetPath(
       "camera_calibration", "",
       doc("the camera's intrinsics and image size: a camera.yaml (OpenCV's keys); empty: 640 x 480, fx = fy = 530, "

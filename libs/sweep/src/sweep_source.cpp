@@ -2,16 +2,18 @@
 
 #include <memory>
 
-#include "mbot/drivers/source.hpp"
-#include "mbot/drivers/source_options.hpp"
+#include <stdexcept>
+
+#include "mbot/msgs/source.hpp"
+#include "mbot/msgs/source.hpp"
 #include "mbot/sweep/merge.hpp"
 
 namespace mbot::sweep {
 namespace {
 
-class SweepFolderSource : public drivers::Source {
+class SweepFolderSource : public msgs::Source {
  public:
-  std::optional<drivers::Event> Next() override { return std::nullopt; }
+  std::optional<msgs::Event> Next() override { return std::nullopt; }
   double Progress() const override { return 1.0; }
   std::string Format() const override { return "sweep folder"; }
   bool events_expected() const override { return false; }
@@ -20,14 +22,15 @@ class SweepFolderSource : public drivers::Source {
 }  // namespace
 
 void RegisterSweepSource() {
-  if (drivers::FindSourceType("sweep")) return;
-  drivers::RegisterSourceType(
+  if (msgs::FindSourceType("sweep")) return;
+  msgs::RegisterSourceType(
       {"sweep", "a sweep folder (sweep.json, jobs.txt and jobs/<id>/ from a [sweep] config), for merge_sweep",
        [](const std::string& path) { return IsSweepFolder(path); }, -1, nullptr,
-       [](const drivers::SourceOptions& o) -> std::unique_ptr<drivers::Source> {
+       [](const msgs::SourceOptions& o) -> std::unique_ptr<msgs::Source> {
          if (!IsSweepFolder(o.path)) throw std::runtime_error(o.path + ": not a sweep folder (no sweep.json in it)");
          return std::make_unique<SweepFolderSource>();
-       }});
+       },
+       msgs::SourceType::Path::kFileOrFolder});
 }
 
 }  // namespace mbot::sweep

@@ -18,24 +18,15 @@
 #include "mbot/mapping/moving_scan.hpp"
 #include "mbot/mapping/particle_filter.hpp"
 #include "mbot/mapping/sensor_model.hpp"
+#include "mbot/msgs/status.hpp"
 
 namespace mbot::mapping {
 
-enum class SlamMode { kMappingOnly, kActionOnly, kLocalization, kFullSlam, kGraphSlam };
-const char* ToString(SlamMode mode);
-
-// What SLAM's pose is worth, published as SLAM_STATUS: the mapping modes map; localization has not
-// settled yet (global search), has settled, or has lost the robot.
-enum class SlamState { kMapping, kLocalizing, kLocalized, kLost };
-const char* ToString(SlamState state);  // "mapping", "localizing", "localized", "lost"
+using msgs::SlamMode;
+using msgs::SlamState;
+using msgs::SlamStatus;
+using msgs::ToString;
 SlamState StateOf(SlamMode mode, const FilterStatus& status);
-
-// SLAM's status: its state, its mode and the particles' spread.
-struct SlamStatus {
-  SlamState state = SlamState::kMapping;
-  SlamMode mode = SlamMode::kFullSlam;
-  double spread_m = 0.0;
-};
 
 struct SlamOptions {
   SlamMode mode = SlamMode::kFullSlam;
@@ -106,6 +97,22 @@ class Slam {
   // Graph SLAM: every scan's pose from the optimised graph, one per ProcessScan call; empty otherwise.
   std::vector<motion::Pose2D> Trajectory() const;
   const GraphSlam* graph() const { return graph_.get(); }
+  // The mode's answers, so a caller need not ask for the mode: particles to show (the filter runs:
+  // not mapping-only, not graph SLAM); a map that grows (not localization).
+  bool HasParticles() const { return UsesFilter() && !graph_; }
+  bool BuildsMap() const { return options_.mode != SlamMode::kLocalization; }
+
+  // A person's say (the viewer), in the particle filter's modes: mapping off keeps the map as it is
+  // (full SLAM then localizes on it); localization off lets the pose follow odometry alone (the
+  // filter waits, and takes up the whole motion when switched on again); ClearMap forgets every
+  // cell and keeps the pose and the map frame. Each throws std::invalid_argument saying why when
+  // the mode cannot (graph SLAM maps every scan; localization keeps its known map; mapping-only
+  // takes its poses from a reference).
+  void SetMapping(bool on);
+  void SetLocalization(bool on);
+  void ClearMap();
+  bool mapping_on() const { return mapping_on_; }
+  bool localization_on() const { return localization_on_; }
 
   const OccupancyGrid& map() const { return graph_ ? graph_->map() : mapper_.map(); }
   const ParticleFilter& filter() const { return filter_; }
@@ -124,6 +131,7 @@ class Slam {
   std::unique_ptr<GraphSlam> graph_;
   bool initialized_ = false;
   bool sensor_stale_ = true;
+  bool mapping_on_ = true, localization_on_ = true;
   motion::Pose2D last_odometry_;  // odometry at the last filter update
   motion::Pose2D last_estimate_;  // the estimate then
 };

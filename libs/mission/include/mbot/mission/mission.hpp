@@ -22,6 +22,7 @@
 #include "mbot/motion/motion_controller.hpp"
 #include "mbot/motion/odometry_continuity.hpp"
 #include "mbot/motion/pose2d.hpp"
+#include "mbot/msgs/events.hpp"
 #include "mbot/planning/exploration.hpp"
 
 namespace mbot::mission {
@@ -94,6 +95,8 @@ struct MissionOptions {
   double backoff_s = 0.6;   // reversing at 0.1 m/s
   int max_stalls = 10;      // stalls on the way to one goal before the mission gives up
   double dwell_s = 2.5;     // warehouse: standing at a stop (lifting, setting down) [s]
+  // A person at the viewer: teleop drives only while its commands keep coming (the dead man).
+  double teleop_timeout_s = 0.5;
   HeavyLiftOptions heavy_lift;
 };
 
@@ -106,7 +109,13 @@ struct PathOut {
 struct ForkOut {
   double height_m = 0;
 };
-using MissionOutput = std::variant<MissionStatus, PathOut, motion::VelocityCommand, ForkOut>;
+// explore: what the explorer sees at each of its steps (for a viewer): its frontiers and the
+// distances its planner keeps from obstacles.
+struct ExplorationOut {
+  msgs::Frontiers frontiers;
+  std::shared_ptr<const msgs::DistanceGrid> distances;
+};
+using MissionOutput = std::variant<MissionStatus, PathOut, motion::VelocityCommand, ForkOut, ExplorationOut>;
 
 // Counters for the mission's report.
 struct MissionReport {
@@ -143,6 +152,16 @@ class Mission {
   void OnSlamState(mapping::SlamState state);
   // follow: a path sent by a GUI (replaces the one being driven).
   void OnPath(const std::vector<motion::Pose2D>& path);
+  // A person takes over (the viewer): a goal to drive to (A* on the mission's map, map frame), or a
+  // teleop command (clamped to the controller's limits; it stops when the commands stop coming for
+  // teleop_timeout_s). Either way the task is paused for the rest of the run: the robot does what
+  // the person says, and holds still in between.
+  void OnGoal(const motion::Pose2D& goal);
+  void OnTeleop(int64_t t_us, double v_m_s, double w_rad_s);
+  bool manual() const { return manual_; }
+  // Someone watches the run (an output: a viewer): the tasks also say what they see (frontiers,
+  // obstacle distances), which costs a copy per exploration step. Off by default.
+  void set_watched(bool watched) { watched_ = watched; }
   // heavy_lift: the tags in a camera frame taken at t_us (robot frame), and the forklift's report.
   void OnTags(int64_t t_us, const std::vector<TagSeen>& tags);
   void OnForklift(const ForkliftState& state) { forklift_ = state; }
@@ -164,6 +183,8 @@ class Mission {
   void Hold();                                                        // command zero velocity this step
   void Drive(double v_m_s, double w_rad_s) { Send(v_m_s, w_rad_s); }  // this step's command, from the task
   void CommandFork(double height_m);                                  // heavy_lift: the tines' target height
+  void ShowExploration(ExplorationOut seen);                          // explore: for a viewer
+  bool watched() const { return watched_; }
   const std::optional<ForkliftState>& forklift() const { return forklift_; }
   // The pose at t_us (map frame): the SLAM pose moved by odometry; false outside the odometry kept.
   bool PoseAt(int64_t t_us, motion::Pose2D* pose) const;
@@ -206,6 +227,12 @@ class Mission {
   long long commands_ = 0, paths_ = 0, stale_stops_ = 0;
   int corrections_ = 0, total_corrections_ = 0, recoveries_ = 0, stalls_this_goal_ = 0;
   motion::VelocityCommand last_command_;
+  bool ManualStep(const motion::Pose2D& pose, double dt);
+  bool watched_ = false;
+  bool manual_ = false;                        // a person took over
+  std::optional<motion::Pose2D> person_goal_;  // to plan for
+  motion::VelocityCommand teleop_;             // the last teleop command …
+  int64_t teleop_until_us_ = -1;               // … in force until then
   int64_t stuck_since_us_ = -1, backoff_until_us_ = 0;
 };
 

@@ -19,6 +19,7 @@
 // where the filter uses max(sqrt(k·|x|), floor); the two agree wherever k·|x| ≫ floor².
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,13 @@ struct ActionModelFit {
 // times) and must have the same length ≥ window_steps + 1; trailing samples that do not fill a
 // window are ignored. Never throws: bad input, invalid options, no usable window, or no window
 // that translated (k2 unobservable) return converged = false with the reason in `message`.
+// A logger writes messages when they arrive, and a robot's messages can arrive in bursts over a
+// second late, while the ground truth is placed on the log clock. Places each sample of `series` at
+// its own stamp plus the clock offset of the least-delayed one (min over samples of event time −
+// stamp), re-sorted; returns the largest delay removed [s], or -1 (nothing changed) when a sample
+// has no stamp (<= 0) or the sizes disagree.
+double PlaceOnStamps(std::vector<TimedPose>* series, const std::vector<int64_t>& stamps);
+
 ActionModelFit FitActionModel(const std::vector<Pose2D>& odometry, const std::vector<Pose2D>& truth,
                               const ActionModelFitOptions& options);
 

@@ -14,14 +14,12 @@
 #include <vector>
 
 #include "mbot/motion/pose2d.hpp"
+#include "mbot/msgs/status.hpp"
 
 namespace mbot::motion {
 
-// Body-frame velocity command: forward speed (m/s) and counter-clockwise turn rate (rad/s).
-struct VelocityCommand {
-  double v_m_s = 0.0;
-  double w_rad_s = 0.0;
-};
+// Body-frame velocity command (the message vocabulary's): forward speed (m/s), turn rate (rad/s).
+using msgs::VelocityCommand;
 
 enum class ControllerKind { kRotateTranslateRotate, kPurePursuit };
 

@@ -1,24 +1,16 @@
-// Planar poses (x, y in metres, theta in radians) and the SE(2) operations the stack shares.
+// Planar poses: the message vocabulary's Pose2D (libs/msgs), and the operations on poses the
+// algorithms share (interpolation, odometry steps, timed series).
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
+#include "mbot/msgs/pose2d.hpp"
+
 namespace mbot::motion {
 
-// Wraps an angle to (-pi, pi].
-double WrapAngle(double a);
-
-struct Pose2D {
-  double x = 0.0;
-  double y = 0.0;
-  double theta = 0.0;
-
-  // this ⊕ other: `other` expressed in this pose's frame, mapped to the world frame.
-  Pose2D Compose(const Pose2D& other) const;
-  // The pose that composes with this one to the identity.
-  Pose2D Inverse() const;
-};
+using msgs::Pose2D;
+using msgs::WrapAngle;
 
 // Linear interpolation of position and shortest-arc interpolation of heading; s in [0, 1].
 Pose2D Interpolate(const Pose2D& a, const Pose2D& b, double s);

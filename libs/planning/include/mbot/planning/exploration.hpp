@@ -68,6 +68,8 @@ class Explorer {
   const motion::Pose2D& home() const { return home_; }
   const std::vector<motion::Pose2D>& path() const { return path_; }
   const std::vector<Frontier>& frontiers() const { return frontiers_; }
+  // The distances the planner keeps from obstacles, as of the last update.
+  const ObstacleDistanceGrid& distances() const { return distances_; }
   // Completed or incomplete: the frontiers left on the map when the robot reached home (none when
   // completed).
   const std::vector<FrontierLeft>& left() const { return left_; }

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "mbot/drivers/events.hpp"
+#include "mbot/msgs/events.hpp"
 #include "mbot/mapping/occupancy_grid.hpp"
 #include "mbot/mapping/slam.hpp"
 #include "mbot/mission/mission_state.hpp"
@@ -100,9 +100,16 @@ struct Score {
 int PosePoints(const PoseError& e);
 // Lap time tiers: < 15 s → 100, < 20 s → 75, < 30 s → 50.
 int LapPoints(double seconds);
-// The map (in the frame of `start`) against the world: coverage of the reachable free space and
-// precision of the walls.
-MapQuality Quality(const World& world, const mapping::OccupancyGrid& map, const motion::Pose2D& start);
+// What Quality needs of the world for one start, whatever the map: the true cells the robot can
+// reach and their clearance from the walls. The referee works it out once per run.
+struct ReachableCells {
+  motion::Pose2D start;
+  std::vector<double> x, y, clearance;  // world frame [m]
+};
+ReachableCells FindReachableCells(const World& world, const motion::Pose2D& start);
+// The map (in the frame of `reachable.start`) against the world: coverage of the reachable free
+// space and precision of the walls.
+MapQuality Quality(const World& world, const mapping::OccupancyGrid& map, const ReachableCells& reachable);
 
 class Referee {
  public:
@@ -118,7 +125,7 @@ class Referee {
   void OnSlamState(int64_t t_us, mapping::SlamState state);
   void OnMissionStatus(int64_t t_us, const mission::MissionStatus& status);
   // Heavy Lift: the simulator's crates as they are now.
-  void OnCrates(const drivers::CrateStates& crates) { crates_ = crates; }
+  void OnCrates(const msgs::CrateStates& crates) { crates_ = crates; }
   // Why the run should end now — the mission ended finish_delay_s ago, or the time limit — once;
   // nullopt otherwise.
   std::optional<std::string> StopReason(int64_t t_us);
@@ -136,6 +143,7 @@ class Referee {
 
   RefereeOptions o_;
   World world_;
+  mutable std::optional<ReachableCells> reachable_;  // for Quality: the same for every Judge of a run
   int64_t t0_us_ = -1, last_us_ = 0, end_us_ = -1, localized_us_ = -1;
   std::vector<motion::TimedPose> truth_, slam_;
   std::shared_ptr<const mapping::OccupancyGrid> map_;
@@ -150,7 +158,7 @@ class Referee {
   bool left_last_stop_ = true;         // the robot has moved off the last stop done
   int64_t near_since_us_ = -1;
   // Heavy Lift.
-  drivers::CrateStates crates_;
+  msgs::CrateStates crates_;
 };
 
 }  // namespace mbot::sim

@@ -33,35 +33,23 @@
 #include <random>
 #include <vector>
 
-#include "mbot/drivers/events.hpp"
+#include "mbot/msgs/events.hpp"
 #include "mbot/sim/forklift.hpp"
 #include "mbot/sim/sim_camera.hpp"
 #include "mbot/sim/world.hpp"
 #include "mbot/motion/gyrodometry.hpp"
 #include "mbot/motion/motor_model.hpp"
 #include "mbot/motion/wheel_controller.hpp"
+#include "mbot/msgs/topics.hpp"
 
 namespace mbot::sim {
 
-// The simulator speaks the project's own event types (libs/drivers/events.hpp).
-using drivers::Event;
-using drivers::EventKind;
+// The simulator speaks the project's own event types (libs/msgs: events.hpp).
+using msgs::Event;
+using msgs::EventKind;
 
-// The channels the simulated robot publishes on.
-namespace sim_channel {
-inline constexpr const char* kEncoders = "MBOT_ENCODERS";
-inline constexpr const char* kImu = "MBOT_IMU";
-inline constexpr const char* kOdometry = "MBOT_ODOMETRY";
-inline constexpr const char* kMotorPwm = "MBOT_MOTOR_PWM";
-inline constexpr const char* kMotorVel = "MBOT_MOTOR_VEL";
-inline constexpr const char* kLidar = "LIDAR";
-inline constexpr const char* kTruePose = "TRUE_POSE";
-inline constexpr const char* kCollision = "SIM_COLLISION";
-inline constexpr const char* kForkliftStatus = "MBOT_FORKLIFT_STATUS";
-inline constexpr const char* kForkliftCommand = "MBOT_FORKLIFT_CMD";
-inline constexpr const char* kCrates = "SIM_CRATES";
-inline constexpr const char* kCamera = "CAMERA";
-}  // namespace sim_channel
+// The channels the simulated robot publishes on are the pipeline's topics (msgs/topics.hpp).
+namespace topics = msgs::topics;
 
 struct SimLidarOptions {
   double rate_hz = 8.0;  // revolutions per second

@@ -13,21 +13,21 @@
 
 #include "mbot/sim/sim_robot.hpp"
 #include "mbot/sim/world.hpp"
-#include "mbot/drivers/sink.hpp"
-#include "mbot/drivers/source.hpp"
-#include "mbot/drivers/source_options.hpp"
+#include "mbot/msgs/sink.hpp"
+#include "mbot/msgs/source.hpp"
+#include "mbot/msgs/source.hpp"
 #include "mbot/sim/sim_source_options.hpp"
 
 namespace mbot::sim {
 
-class SimSource : public drivers::Source, public drivers::Sink {
+class SimSource : public msgs::Source, public msgs::Sink {
  public:
-  drivers::Sink* sink() override { return this; }
+  msgs::Sink* sink() override { return this; }
   // Loads options.path as the world (World::Load) and places the robot at sim.start, or at the
   // world's `start` pose; options.seed seeds its noise. Throws std::runtime_error naming the path
   // (and [source] start when the world has no start pose) or std::invalid_argument when the start
   // collides.
-  SimSource(const drivers::SourceOptions& options, const SimSourceOptions& sim);
+  SimSource(const msgs::SourceOptions& options, const SimSourceOptions& sim);
   SimSource(const SimSource&) = delete;  // the robot holds a reference to world_
   SimSource& operator=(const SimSource&) = delete;
 

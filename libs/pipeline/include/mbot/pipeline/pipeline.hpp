@@ -1,0 +1,66 @@
+// The pipeline runner: builds the pipeline an INI file describes ([pipeline], [output], [source],
+// the stage sections and the output sections, from the registries of libs/msgs) and runs it on the
+// event stream. Registering the types (mbot::app::RegisterAll) is the program's job, before BuildPlan.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mbot/common/config.hpp"
+#include "mbot/msgs/outputs.hpp"
+#include "mbot/msgs/source.hpp"
+#include "mbot/msgs/stage.hpp"
+
+namespace mbot::pipeline {
+
+using msgs::EventResult;
+using msgs::Stage;
+
+struct PipelineOptions {
+  std::vector<std::string> stages;   // section names, in order
+  std::vector<std::string> outputs;  // section names: where every event of the run also goes
+  uint64_t seed = 1;
+  std::string progress = "auto";  // auto, bar, lines, off
+  long long max_events = 0;       // 0: all
+  double playback_speed = 0.0;    // a recording paced to this many times real time (0: unpaced)
+};
+
+struct OutputFolder {
+  std::string dir = "out";
+};
+
+// Everything parsed and validated from a Config, before anything is opened or run.
+struct PipelinePlan {
+  PipelineOptions pipeline;
+  OutputFolder output;
+  msgs::SourceOptions source;
+  std::vector<std::pair<std::string, std::unique_ptr<Stage>>> stages;  // section name, stage
+  struct PlannedOutput {
+    std::string name;  // its section
+    std::unique_ptr<msgs::Output> output;
+    msgs::OutputOptions options;
+  };
+  std::vector<PlannedOutput> outputs;
+};
+
+// Parses [pipeline], [output], [source] and every stage section strictly: unknown sections, unknown
+// keys, missing required keys and bad values throw config::ConfigError naming file, section, key.
+PipelinePlan BuildPlan(const config::Config& config);
+
+struct RunSummary {
+  long long events = 0;
+  double data_seconds = 0.0;
+  double wall_seconds = 0.0;
+  bool interrupted = false;
+  std::string stopped_by;                   // the reason a stage gave when it ended the run, else ""
+  std::optional<EventResult> event_result;  // what a referee reported (RunContext::event_result)
+  std::vector<std::pair<std::string, msgs::OutputCounts>> outputs;  // per output: sent, dropped, failed
+};
+
+// Opens the source and runs every event through the stages until the end of the input or until
+// `stop` becomes true; then every stage's Finish writes its outputs.
+RunSummary RunPlan(PipelinePlan& plan, const std::atomic<bool>& stop);
+
+}  // namespace mbot::pipeline

@@ -1,0 +1,113 @@
+// The ROS 2 messages the MBot's generation speaks (Jazzy; written from the public .msg files of
+// common_interfaces and geometry2), as plain structs, and their CDR encoding. Field order and types
+// follow the .msg files exactly; each Decode throws CdrError naming the field and offset of what
+// does not fit.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "mbot/ros2/cdr.hpp"
+
+namespace mbot::ros2 {
+
+struct Time {  // builtin_interfaces/Time
+  int32_t sec = 0;
+  uint32_t nanosec = 0;
+};
+struct Header {  // std_msgs/Header
+  Time stamp;
+  std::string frame_id;
+};
+struct Vector3 {  // geometry_msgs/Vector3 (and Point: the same three float64)
+  double x = 0, y = 0, z = 0;
+};
+struct Quaternion {  // geometry_msgs/Quaternion
+  double x = 0, y = 0, z = 0, w = 1;
+};
+struct Pose {  // geometry_msgs/Pose
+  Vector3 position;
+  Quaternion orientation;
+};
+struct Twist {  // geometry_msgs/Twist
+  Vector3 linear, angular;
+};
+struct Transform {  // geometry_msgs/Transform
+  Vector3 translation;
+  Quaternion rotation;
+};
+struct TransformStamped {  // geometry_msgs/TransformStamped
+  Header header;
+  std::string child_frame_id;
+  Transform transform;
+};
+struct TFMessage {  // tf2_msgs/TFMessage
+  std::vector<TransformStamped> transforms;
+};
+struct LaserScan {  // sensor_msgs/LaserScan
+  Header header;
+  float angle_min = 0, angle_max = 0, angle_increment = 0;
+  float time_increment = 0, scan_time = 0;
+  float range_min = 0, range_max = 0;
+  std::vector<float> ranges, intensities;
+};
+struct Odometry {  // nav_msgs/Odometry
+  Header header;
+  std::string child_frame_id;
+  Pose pose;
+  std::array<double, 36> pose_covariance{};
+  Twist twist;
+  std::array<double, 36> twist_covariance{};
+};
+struct Imu {  // sensor_msgs/Imu
+  Header header;
+  Quaternion orientation;
+  std::array<double, 9> orientation_covariance{};
+  Vector3 angular_velocity;
+  std::array<double, 9> angular_velocity_covariance{};
+  Vector3 linear_acceleration;
+  std::array<double, 9> linear_acceleration_covariance{};
+};
+
+struct PoseStamped {  // geometry_msgs/PoseStamped
+  Header header;
+  Pose pose;
+};
+struct PoseWithCovarianceStamped {  // geometry_msgs/PoseWithCovarianceStamped (amcl's pose)
+  Header header;
+  Pose pose;
+  std::array<double, 36> covariance{};
+};
+
+// The ROS 2 type names ("sensor_msgs/msg/LaserScan"), as rosbag2 and the DDS layer name them.
+inline constexpr const char* kLaserScanType = "sensor_msgs/msg/LaserScan";
+inline constexpr const char* kOdometryType = "nav_msgs/msg/Odometry";
+inline constexpr const char* kImuType = "sensor_msgs/msg/Imu";
+inline constexpr const char* kTwistType = "geometry_msgs/msg/Twist";
+inline constexpr const char* kTFMessageType = "tf2_msgs/msg/TFMessage";
+inline constexpr const char* kPoseStampedType = "geometry_msgs/msg/PoseStamped";
+inline constexpr const char* kPoseWithCovarianceStampedType = "geometry_msgs/msg/PoseWithCovarianceStamped";
+
+LaserScan DecodeLaserScan(const uint8_t* data, size_t size);
+Odometry DecodeOdometry(const uint8_t* data, size_t size);
+Imu DecodeImu(const uint8_t* data, size_t size);
+Twist DecodeTwist(const uint8_t* data, size_t size);
+TFMessage DecodeTFMessage(const uint8_t* data, size_t size);
+PoseStamped DecodePoseStamped(const uint8_t* data, size_t size);
+PoseWithCovarianceStamped DecodePoseWithCovarianceStamped(const uint8_t* data, size_t size);
+
+std::vector<uint8_t> Encode(const LaserScan& m);
+std::vector<uint8_t> Encode(const Odometry& m);
+std::vector<uint8_t> Encode(const Imu& m);
+std::vector<uint8_t> Encode(const Twist& m);
+std::vector<uint8_t> Encode(const TFMessage& m);
+std::vector<uint8_t> Encode(const PoseStamped& m);
+std::vector<uint8_t> Encode(const PoseWithCovarianceStamped& m);
+
+// A planar yaw from a quaternion, and back (the MBot's frames differ by yaw only).
+double Yaw(const Quaternion& q);
+Quaternion FromYaw(double yaw);
+
+}  // namespace mbot::ros2

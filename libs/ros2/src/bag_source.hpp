@@ -1,0 +1,61 @@
+// Replays a ROS 2 bag (rosbag2, storage mcap) or an MCAP file of ROS 2 messages as an Event stream:
+// LaserScan → lidar (the mount from /tf_static), Odometry → odometry, Imu → imu, Twist →
+// velocity command, PoseStamped / PoseWithCovarianceStamped → the pose role of their topic.
+#pragma once
+
+#include <climits>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "mbot/msgs/source.hpp"
+#include "mbot/ros2/mcap_reader.hpp"
+#include "mbot/ros2/messages.hpp"
+#include "mbot/ros2/ros2_transport.hpp"
+#include "mbot/ros2/transforms.hpp"
+
+namespace mbot::ros2 {
+
+// The files of a bag: a folder's .mcap files in metadata.yaml's order (else by name), or the file.
+std::vector<std::string> BagFiles(const std::string& path);
+
+class McapBagSource : public msgs::Source {
+ public:
+  explicit McapBagSource(const msgs::SourceOptions& options);
+  std::optional<msgs::Event> Next() override;
+  double Progress() const override;
+  std::string Format() const override { return "ROS 2 bag (MCAP)"; }
+  std::vector<std::pair<std::string, std::string>> Details() const override;
+
+ private:
+  bool ReadMore();  // one more message into pending_; false at the end of the last file
+  void Handle(const McapMessage& m);
+  void Reject(const std::string& topic, const McapMessage& m, const std::string& why);
+  bool LidarEvent(const LaserScan& scan, const std::string& topic, msgs::Event* ev);
+  std::optional<msgs::Pose2D> Mount(const std::string& frame, bool* mirrored);
+
+  msgs::SourceOptions options_;
+  BagSourceOptions bag_;
+  std::vector<std::string> files_;
+  size_t file_index_ = 0;
+  std::unique_ptr<McapReader> reader_;
+  uint64_t bytes_before_ = 0, bytes_total_ = 0;  // of the files before the current one, of all
+  std::multimap<int64_t, msgs::Event> pending_;  // by t_us, within the reorder window
+  int64_t last_emitted_us_ = INT64_MIN;
+  bool eof_ = false;
+  StaticTransforms tf_static_;
+  std::string odom_child_frame_;
+  struct MountCache {
+    msgs::Pose2D pose;
+    bool mirrored = false;
+  };
+  std::map<std::string, MountCache> mounts_;  // scan frame → its mount, once the tree connects it
+  std::set<std::string> warned_;
+  long long messages_ = 0, chunks_ = 0, crcs_ = 0;
+};
+
+}  // namespace mbot::ros2

@@ -1,0 +1,200 @@
+#include "mbot/ros2/messages.hpp"
+
+#include <cmath>
+
+namespace mbot::ros2 {
+
+namespace {
+
+Header ReadHeader(CdrReader& r) {
+  Header h;
+  h.stamp.sec = r.I32("header.stamp.sec");
+  h.stamp.nanosec = r.U32("header.stamp.nanosec");
+  h.frame_id = r.String("header.frame_id");
+  return h;
+}
+void WriteHeader(CdrWriter& w, const Header& h) {
+  w.I32(h.stamp.sec);
+  w.U32(h.stamp.nanosec);
+  w.String(h.frame_id);
+}
+Vector3 ReadVector3(CdrReader& r, const char* field) {
+  Vector3 v;
+  v.x = r.F64(field), v.y = r.F64(field), v.z = r.F64(field);
+  return v;
+}
+void WriteVector3(CdrWriter& w, const Vector3& v) { w.F64(v.x), w.F64(v.y), w.F64(v.z); }
+Quaternion ReadQuaternion(CdrReader& r, const char* field) {
+  Quaternion q;
+  q.x = r.F64(field), q.y = r.F64(field), q.z = r.F64(field), q.w = r.F64(field);
+  return q;
+}
+void WriteQuaternion(CdrWriter& w, const Quaternion& q) { w.F64(q.x), w.F64(q.y), w.F64(q.z), w.F64(q.w); }
+Twist ReadTwist(CdrReader& r) {
+  Twist t;
+  t.linear = ReadVector3(r, "twist.linear");
+  t.angular = ReadVector3(r, "twist.angular");
+  return t;
+}
+void WriteTwist(CdrWriter& w, const Twist& t) { WriteVector3(w, t.linear), WriteVector3(w, t.angular); }
+
+}  // namespace
+
+LaserScan DecodeLaserScan(const uint8_t* data, size_t size) {
+  CdrReader r(data, size);
+  LaserScan m;
+  m.header = ReadHeader(r);
+  m.angle_min = r.F32("angle_min");
+  m.angle_max = r.F32("angle_max");
+  m.angle_increment = r.F32("angle_increment");
+  m.time_increment = r.F32("time_increment");
+  m.scan_time = r.F32("scan_time");
+  m.range_min = r.F32("range_min");
+  m.range_max = r.F32("range_max");
+  m.ranges = r.F32s("ranges");
+  m.intensities = r.F32s("intensities");
+  return m;
+}
+
+Odometry DecodeOdometry(const uint8_t* data, size_t size) {
+  CdrReader r(data, size);
+  Odometry m;
+  m.header = ReadHeader(r);
+  m.child_frame_id = r.String("child_frame_id");
+  m.pose.position = ReadVector3(r, "pose.pose.position");
+  m.pose.orientation = ReadQuaternion(r, "pose.pose.orientation");
+  r.F64Array("pose.covariance", m.pose_covariance.data(), 36);
+  m.twist = ReadTwist(r);
+  r.F64Array("twist.covariance", m.twist_covariance.data(), 36);
+  return m;
+}
+
+Imu DecodeImu(const uint8_t* data, size_t size) {
+  CdrReader r(data, size);
+  Imu m;
+  m.header = ReadHeader(r);
+  m.orientation = ReadQuaternion(r, "orientation");
+  r.F64Array("orientation_covariance", m.orientation_covariance.data(), 9);
+  m.angular_velocity = ReadVector3(r, "angular_velocity");
+  r.F64Array("angular_velocity_covariance", m.angular_velocity_covariance.data(), 9);
+  m.linear_acceleration = ReadVector3(r, "linear_acceleration");
+  r.F64Array("linear_acceleration_covariance", m.linear_acceleration_covariance.data(), 9);
+  return m;
+}
+
+Twist DecodeTwist(const uint8_t* data, size_t size) {
+  CdrReader r(data, size);
+  return ReadTwist(r);
+}
+
+TFMessage DecodeTFMessage(const uint8_t* data, size_t size) {
+  CdrReader r(data, size);
+  TFMessage m;
+  // A transform takes at least 4 + 8 (stamp, an empty frame) + 4 (child) + 56 bytes.
+  const uint32_t n = r.Count("transforms", 72);
+  m.transforms.resize(n);
+  for (TransformStamped& t : m.transforms) {
+    t.header = ReadHeader(r);
+    t.child_frame_id = r.String("transforms.child_frame_id");
+    t.transform.translation = ReadVector3(r, "transforms.transform.translation");
+    t.transform.rotation = ReadQuaternion(r, "transforms.transform.rotation");
+  }
+  return m;
+}
+
+PoseStamped DecodePoseStamped(const uint8_t* data, size_t size) {
+  CdrReader r(data, size);
+  PoseStamped m;
+  m.header = ReadHeader(r);
+  m.pose.position = ReadVector3(r, "pose.position");
+  m.pose.orientation = ReadQuaternion(r, "pose.orientation");
+  return m;
+}
+
+PoseWithCovarianceStamped DecodePoseWithCovarianceStamped(const uint8_t* data, size_t size) {
+  CdrReader r(data, size);
+  PoseWithCovarianceStamped m;
+  m.header = ReadHeader(r);
+  m.pose.position = ReadVector3(r, "pose.pose.position");
+  m.pose.orientation = ReadQuaternion(r, "pose.pose.orientation");
+  r.F64Array("pose.covariance", m.covariance.data(), 36);
+  return m;
+}
+
+std::vector<uint8_t> Encode(const LaserScan& m) {
+  CdrWriter w;
+  WriteHeader(w, m.header);
+  for (float v :
+       {m.angle_min, m.angle_max, m.angle_increment, m.time_increment, m.scan_time, m.range_min, m.range_max}) {
+    w.F32(v);
+  }
+  w.F32s(m.ranges);
+  w.F32s(m.intensities);
+  return w.bytes();
+}
+
+std::vector<uint8_t> Encode(const Odometry& m) {
+  CdrWriter w;
+  WriteHeader(w, m.header);
+  w.String(m.child_frame_id);
+  WriteVector3(w, m.pose.position);
+  WriteQuaternion(w, m.pose.orientation);
+  w.F64Array(m.pose_covariance.data(), 36);
+  WriteTwist(w, m.twist);
+  w.F64Array(m.twist_covariance.data(), 36);
+  return w.bytes();
+}
+
+std::vector<uint8_t> Encode(const Imu& m) {
+  CdrWriter w;
+  WriteHeader(w, m.header);
+  WriteQuaternion(w, m.orientation);
+  w.F64Array(m.orientation_covariance.data(), 9);
+  WriteVector3(w, m.angular_velocity);
+  w.F64Array(m.angular_velocity_covariance.data(), 9);
+  WriteVector3(w, m.linear_acceleration);
+  w.F64Array(m.linear_acceleration_covariance.data(), 9);
+  return w.bytes();
+}
+
+std::vector<uint8_t> Encode(const Twist& m) {
+  CdrWriter w;
+  WriteTwist(w, m);
+  return w.bytes();
+}
+
+std::vector<uint8_t> Encode(const TFMessage& m) {
+  CdrWriter w;
+  w.U32(static_cast<uint32_t>(m.transforms.size()));
+  for (const TransformStamped& t : m.transforms) {
+    WriteHeader(w, t.header);
+    w.String(t.child_frame_id);
+    WriteVector3(w, t.transform.translation);
+    WriteQuaternion(w, t.transform.rotation);
+  }
+  return w.bytes();
+}
+
+std::vector<uint8_t> Encode(const PoseStamped& m) {
+  CdrWriter w;
+  WriteHeader(w, m.header);
+  WriteVector3(w, m.pose.position);
+  WriteQuaternion(w, m.pose.orientation);
+  return w.bytes();
+}
+
+std::vector<uint8_t> Encode(const PoseWithCovarianceStamped& m) {
+  CdrWriter w;
+  WriteHeader(w, m.header);
+  WriteVector3(w, m.pose.position);
+  WriteQuaternion(w, m.pose.orientation);
+  w.F64Array(m.covariance.data(), 36);
+  return w.bytes();
+}
+
+double Yaw(const Quaternion& q) {
+  return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
+}
+Quaternion FromYaw(double yaw) { return {0.0, 0.0, std::sin(yaw / 2), std::cos(yaw / 2)}; }
+
+}  // namespace mbot::ros2

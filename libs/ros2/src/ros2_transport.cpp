@@ -1,0 +1,77 @@
+#include "mbot/ros2/ros2_transport.hpp"
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "bag_source.hpp"
+#include "mbot/common/config.hpp"
+#include "mbot/msgs/source.hpp"
+
+namespace mbot::ros2 {
+
+namespace topics = msgs::topics;
+
+msgs::TopicTable DefaultTopics() {
+  return msgs::TopicTable({{topics::kLidar, "/scan"},
+                           {topics::kOdometry, "/odom"},
+                           {topics::kImu, "/imu"},
+                           {topics::kVelocityCommand, "/cmd_vel"},
+                           {topics::kEncoders, "/encoders"},
+                           {topics::kMotorVelocity, "/motor_vel"},
+                           {topics::kSlamMap, "/map"},
+                           {topics::kSlamPose, "/estimated_pose"},
+                           {topics::kSlamParticles, "/particle_cloud"},
+                           {topics::kPath, "/planned_path"},
+                           {topics::kFrontiers, "/frontier_markers"},
+                           {topics::kTruePose, "/ground_truth"}});
+}
+
+namespace {
+
+// A .mcap file (its magic bytes), or a rosbag2 folder holding one.
+bool IsMcapBag(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  std::string file = path;
+  if (fs::is_directory(path, ec)) {
+    try {
+      file = BagFiles(path).front();
+    } catch (const std::exception&) {
+      return false;
+    }
+  }
+  std::ifstream in(file, std::ios::binary);
+  char head[8] = {};
+  in.read(head, 8);
+  return in.gcount() == 8 && std::memcmp(head, "\x89MCAP0\r\n", 8) == 0;
+}
+
+void ParseBagOptions(config::Section& s, msgs::SourceOptions* o) {
+  ParseChannelRoles(s, &o->roles);
+  BagSourceOptions b;
+  b.topics.Parse(s, "topics");
+  b.robot_frame = s.GetString("robot_frame", b.robot_frame,
+                              "mcap: the robot's frame, whose transform to the scan's frame (/tf_static) is the "
+                              "lidar's mount ('' = the frame /odom moves, else base_footprint)");
+  b.reorder_window_us = static_cast<int64_t>(
+      1e6 * s.GetDouble("reorder_window_s", b.reorder_window_us * 1e-6,
+                        "mcap: messages are re-sorted by log time within this window [s]", 0.0, 10.0));
+  o->extra = b;
+}
+
+}  // namespace
+
+void RegisterRos2Transport() {
+  if (msgs::FindSourceType("mcap")) return;
+  msgs::RegisterSourceType({"mcap",
+                            "a ROS 2 bag (rosbag2 with storage mcap: its folder or a .mcap file), or any MCAP file of "
+                            "ROS 2 messages; topics map to the pipeline's by `topics`, messages to events by type",
+                            IsMcapBag,
+                            -1,  // before the file types: a bag may be a folder
+                            ParseBagOptions,
+                            [](const msgs::SourceOptions& o) { return std::make_unique<McapBagSource>(o); },
+                            msgs::SourceType::Path::kFileOrFolder});
+}
+
+}  // namespace mbot::ros2
