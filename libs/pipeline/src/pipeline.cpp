@@ -211,6 +211,23 @@ PipelinePlan BuildPlan(const config::Config& config) {
     s.Finish();
     if (enabled) plan.outputs.push_back({"viewer", std::move(output), std::move(options)});
   }
+  // [record] on any config (--set record.format=mcap): the run recorded as a ROS 2 bag in the output
+  // folder, unless a config lists its own [record] output.
+  if (config.HasSection("record") && !used.count("record")) {
+    used.insert("record");
+    config::Section s = config.GetSection("record");
+    const std::string format = s.GetChoice("format", "none", {"none", "mcap"},
+                                           "record the run: none, or mcap (a ROS 2 bag: run.mcap and metadata.yaml "
+                                           "in the output folder)");
+    if (format == "mcap") {
+      const msgs::OutputType* ot = msgs::FindOutputType("rosbag2");
+      if (!ot) s.Fail("format", "this mbot_nav was built without the ROS 2 transport (libs/ros2)");
+      msgs::OutputOptions options = msgs::ParseOutputOptions(s, *ot);
+      std::unique_ptr<msgs::Output> output = ot->create(s);
+      plan.outputs.push_back({"record", std::move(output), std::move(options)});
+    }
+    s.Finish();
+  }
   for (const std::string& name : config.SectionNames()) {
     if (!used.count(name)) {
       throw config::ConfigError(

@@ -216,6 +216,7 @@ bool McapBagSource::ReadMore() {
     std::error_code ec;
     bytes_before_ += std::filesystem::file_size(files_[file_index_], ec);
     reader_.reset();
+    routes_.clear();  // channel ids are per file
     if (++file_index_ < files_.size()) reader_ = std::make_unique<McapReader>(files_[file_index_]);
   }
   return false;
@@ -303,30 +304,56 @@ bool McapBagSource::LidarEvent(const LaserScan& s, const std::string& topic, Eve
   return true;
 }
 
-void McapBagSource::Handle(const McapMessage& m) {
-  const auto ch = reader_->channels().find(m.channel_id);
-  if (ch == reader_->channels().end()) return;  // the reader checks that a message's channel came first
-  const std::string& wire = ch->second.topic;
+McapBagSource::Route McapBagSource::RouteOf(uint16_t channel_id) {
+  // Once per channel of each file: what its messages are, under which topic.
+  Route r;
+  const auto ch = reader_->channels().find(channel_id);
+  if (ch == reader_->channels().end()) return r;  // the reader checks that a message's channel came first
+  r.wire = ch->second.topic;
   const auto schema = reader_->schemas().find(ch->second.schema_id);
   const std::string type = schema != reader_->schemas().end() ? schema->second.name : "";
-  const std::string topic = bag_.topics.Topic(wire);
-  // Keyed by the pipeline's topic, as the events are (the ROS name in the generation column).
-  msgs::ChannelInfo& info = channels_[topic];
+  r.topic = bag_.topics.Topic(r.wire);
+  msgs::ChannelInfo& info = channels_[r.topic];  // keyed by the pipeline's topic, as the events are
   info.type = type;
-  info.generation = "ROS 2 " + wire + " (" + ch->second.message_encoding + ")";
-  const bool known = type == kLaserScanType || type == kOdometryType || type == kImuType || type == kTwistType ||
-                     type == kTFMessageType || type == kPoseStampedType || type == kPoseWithCovarianceStampedType;
-  if (ch->second.message_encoding != "cdr" || !known) {
+  info.generation = "ROS 2 " + r.wire + " (" + ch->second.message_encoding + ")";
+  r.info = &info;
+  const std::pair<const char*, Route::Type> types[] = {{kLaserScanType, Route::kScan},
+                                                       {kOdometryType, Route::kOdometry},
+                                                       {kImuType, Route::kImu},
+                                                       {kTwistType, Route::kTwist},
+                                                       {kTFMessageType, Route::kTf},
+                                                       {kPoseStampedType, Route::kPoseStamped},
+                                                       {kPoseWithCovarianceStampedType, Route::kPoseWithCovariance}};
+  for (const auto& [name, t] : types) {
+    if (type == name) r.type = t;
+  }
+  if (ch->second.message_encoding != "cdr") r.type = Route::kUnknown;
+  if (r.type == Route::kUnknown) {
     info.decoded = false;
+    mbot::log::Warn(files_[file_index_] + ": topic " + r.wire + " carries " + (type.empty() ? "no schema" : type) +
+                    " (" + ch->second.message_encoding +
+                    "), which this reader does not decode; its messages are "
+                    "skipped");
+  }
+  if (r.type == Route::kTf) info.kind = EventKind::kOther;
+  r.type_name = type;
+  return r;
+}
+
+void McapBagSource::Handle(const McapMessage& m) {
+  auto found = routes_.find(m.channel_id);
+  if (found == routes_.end()) found = routes_.emplace(m.channel_id, RouteOf(m.channel_id)).first;
+  const Route& route = found->second;
+  if (!route.info) return;
+  if (route.type == Route::kUnknown) {
     ++diagnostics_.unknown_messages;
-    if (warned_.insert("type:" + wire).second) {
-      mbot::log::Warn(files_[file_index_] + ": topic " + wire + " carries " + (type.empty() ? "no schema" : type) +
-                      " (" + ch->second.message_encoding +
-                      "), which this reader does not decode; its messages are "
-                      "skipped");
-    }
     return;
   }
+  if (route.type == Route::kTf && route.wire != "/tf_static") return;  // the odometry's, which /odom carries
+  const std::string& wire = route.wire;
+  const std::string& topic = route.topic;
+  const std::string& type = route.type_name;
+  msgs::ChannelInfo& info = *route.info;
   const int64_t t_us = static_cast<int64_t>(m.log_time_ns / 1000);
   if (!msgs::IsPlausibleTimeUs(t_us)) {
     Reject(wire, m, "absurd log time " + std::to_string(m.log_time_ns) + " ns");
@@ -338,15 +365,15 @@ void McapBagSource::Handle(const McapMessage& m) {
   const uint8_t* d = m.data.data();
   const size_t size = m.data.size();
   try {
-    if (type == kLaserScanType) {
+    if (route.type == Route::kScan) {
       if (!LidarEvent(DecodeLaserScan(d, size), wire, &ev)) return;
-    } else if (type == kOdometryType) {
+    } else if (route.type == Route::kOdometry) {
       const Odometry o = DecodeOdometry(d, size);
       if (odom_child_frame_.empty() && !o.child_frame_id.empty()) odom_child_frame_ = o.child_frame_id;
       ev.kind = EventKind::kOdometry;
       ev.stamp_us = StampUs(o.header.stamp);
       ev.payload = Planar(o.pose);
-    } else if (type == kImuType) {
+    } else if (route.type == Route::kImu) {
       const Imu i = DecodeImu(d, size);
       msgs::Imu imu;
       imu.gyro_rad_s[0] = i.angular_velocity.x, imu.gyro_rad_s[1] = i.angular_velocity.y;
@@ -364,16 +391,13 @@ void McapBagSource::Handle(const McapMessage& m) {
       ev.kind = EventKind::kImu;
       ev.stamp_us = StampUs(i.header.stamp);
       ev.payload = imu;
-    } else if (type == kTwistType) {
+    } else if (route.type == Route::kTwist) {
       const Twist t = DecodeTwist(d, size);
       ev.kind = EventKind::kMotorCommand;
       ev.stamp_us = t_us;
       ev.payload = msgs::MotorCommand::Velocity(t.linear.x, t.angular.z);
-    } else if (type == kTFMessageType) {
-      const TFMessage tf = DecodeTFMessage(d, size);
-      info.kind = EventKind::kOther;
-      if (wire != "/tf_static") return;  // the odometry's transform, which /odom also carries
-      const std::string refused = tf_static_.Add(tf);
+    } else if (route.type == Route::kTf) {  // /tf_static
+      const std::string refused = tf_static_.Add(DecodeTFMessage(d, size));
       mounts_.clear();
       if (!refused.empty()) {
         ++diagnostics_.rejected_messages;
@@ -383,7 +407,7 @@ void McapBagSource::Handle(const McapMessage& m) {
       return;
     } else {  // PoseStamped, PoseWithCovarianceStamped: the pose role of the topic
       Pose2D pose;
-      if (type == kPoseStampedType) {
+      if (route.type == Route::kPoseStamped) {
         const PoseStamped p = DecodePoseStamped(d, size);
         pose = Planar(p.pose), ev.stamp_us = StampUs(p.header.stamp);
       } else {

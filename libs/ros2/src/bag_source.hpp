@@ -32,6 +32,13 @@ class McapBagSource : public msgs::Source {
   std::vector<std::pair<std::string, std::string>> Details() const override;
 
  private:
+  // What a channel's messages become, worked out once per channel.
+  struct Route {
+    enum Type { kUnknown, kScan, kOdometry, kImu, kTwist, kTf, kPoseStamped, kPoseWithCovariance } type = kUnknown;
+    std::string wire, topic, type_name;
+    msgs::ChannelInfo* info = nullptr;  // nullptr: a channel the file never declared
+  };
+  Route RouteOf(uint16_t channel_id);
   bool ReadMore();  // one more message into pending_; false at the end of the last file
   void Handle(const McapMessage& m);
   void Reject(const std::string& topic, const McapMessage& m, const std::string& why);
@@ -43,6 +50,7 @@ class McapBagSource : public msgs::Source {
   std::vector<std::string> files_;
   size_t file_index_ = 0;
   std::unique_ptr<McapReader> reader_;
+  std::map<uint16_t, Route> routes_;             // of the current file
   uint64_t bytes_before_ = 0, bytes_total_ = 0;  // of the files before the current one, of all
   std::multimap<int64_t, msgs::Event> pending_;  // by t_us, within the reorder window
   int64_t last_emitted_us_ = INT64_MIN;

@@ -247,7 +247,15 @@ void McapReader::ReadChunk(const uint8_t* data, uint64_t size, uint64_t offset) 
   const uint64_t csize = f.Int<uint64_t>("records");
   const uint8_t* src = f.Take(csize, "records");
   if (usize > kMaxChunkBytes) Fail("a chunk of " + std::to_string(usize) + " bytes (at most 1 GiB)", offset);
-  chunk_.assign(usize, 0);
+  if (compression == "zstd") {
+    // The frame says how much it holds: a chunk that claims more is refused before any allocation.
+    const unsigned long long frame = ZSTD_getFrameContentSize(src, csize);
+    if (frame == ZSTD_CONTENTSIZE_ERROR) Fail("a zstd chunk whose frame header is not zstd's", offset);
+    if (frame != ZSTD_CONTENTSIZE_UNKNOWN && frame != usize)
+      Fail("a zstd chunk whose frame holds " + std::to_string(frame) + " bytes, not its " + std::to_string(usize),
+           offset);
+  }
+  chunk_.resize(usize);  // every byte is written below (or the chunk refused): no need to clear it
   if (compression.empty()) {
     if (csize != usize) Fail("an uncompressed chunk whose sizes differ", offset);
     if (usize) std::memcpy(chunk_.data(), src, usize);

@@ -192,6 +192,40 @@ std::vector<uint8_t> Encode(const PoseWithCovarianceStamped& m) {
   return w.bytes();
 }
 
+std::vector<uint8_t> Encode(const PoseArray& m) {
+  CdrWriter w;
+  WriteHeader(w, m.header);
+  w.U32(static_cast<uint32_t>(m.poses.size()));
+  for (const Pose& p : m.poses) WriteVector3(w, p.position), WriteQuaternion(w, p.orientation);
+  return w.bytes();
+}
+
+std::vector<uint8_t> Encode(const Path& m) {
+  CdrWriter w;
+  WriteHeader(w, m.header);
+  w.U32(static_cast<uint32_t>(m.poses.size()));
+  for (const PoseStamped& p : m.poses) {
+    WriteHeader(w, p.header);
+    WriteVector3(w, p.pose.position);
+    WriteQuaternion(w, p.pose.orientation);
+  }
+  return w.bytes();
+}
+
+std::vector<uint8_t> Encode(const OccupancyGrid& m) {
+  CdrWriter w;
+  WriteHeader(w, m.header);
+  w.I32(m.info.map_load_time.sec);
+  w.U32(m.info.map_load_time.nanosec);
+  w.F32(m.info.resolution);
+  w.U32(m.info.width);
+  w.U32(m.info.height);
+  WriteVector3(w, m.info.origin.position);
+  WriteQuaternion(w, m.info.origin.orientation);
+  w.I8s(m.data);
+  return w.bytes();
+}
+
 double Yaw(const Quaternion& q) {
   return std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
 }

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "bag_recorder.hpp"
 #include "bag_source.hpp"
 #include "mbot/common/config.hpp"
 #include "mbot/msgs/source.hpp"
@@ -72,6 +73,16 @@ void RegisterRos2Transport() {
                             ParseBagOptions,
                             [](const msgs::SourceOptions& o) { return std::make_unique<McapBagSource>(o); },
                             msgs::SourceType::Path::kFileOrFolder});
+  msgs::OutputType recorder;
+  recorder.name = "rosbag2";
+  recorder.doc =
+      "records the run as a ROS 2 bag (rosbag2, storage mcap: run.mcap and metadata.yaml in the output folder) that "
+      "Foxglove, rosbags and ros2 bag open";
+  recorder.create = [](config::Section& s) -> std::unique_ptr<msgs::Output> {
+    return std::make_unique<BagRecorder>(ParseBagRecorderOptions(s));
+  };
+  recorder.wait_when_full = true;  // a recorder loses nothing
+  msgs::RegisterOutputType(std::move(recorder));
 }
 
 }  // namespace mbot::ros2

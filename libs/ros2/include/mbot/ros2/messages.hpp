@@ -80,6 +80,25 @@ struct PoseWithCovarianceStamped {  // geometry_msgs/PoseWithCovarianceStamped (
   Pose pose;
   std::array<double, 36> covariance{};
 };
+struct PoseArray {  // geometry_msgs/PoseArray
+  Header header;
+  std::vector<Pose> poses;
+};
+struct Path {  // nav_msgs/Path
+  Header header;
+  std::vector<PoseStamped> poses;
+};
+struct MapMetaData {  // nav_msgs/MapMetaData
+  Time map_load_time;
+  float resolution = 0;
+  uint32_t width = 0, height = 0;
+  Pose origin;
+};
+struct OccupancyGrid {  // nav_msgs/OccupancyGrid: row-major from the origin; 0-100, -1 unknown
+  Header header;
+  MapMetaData info;
+  std::vector<int8_t> data;
+};
 
 // The ROS 2 type names ("sensor_msgs/msg/LaserScan"), as rosbag2 and the DDS layer name them.
 inline constexpr const char* kLaserScanType = "sensor_msgs/msg/LaserScan";
@@ -89,6 +108,9 @@ inline constexpr const char* kTwistType = "geometry_msgs/msg/Twist";
 inline constexpr const char* kTFMessageType = "tf2_msgs/msg/TFMessage";
 inline constexpr const char* kPoseStampedType = "geometry_msgs/msg/PoseStamped";
 inline constexpr const char* kPoseWithCovarianceStampedType = "geometry_msgs/msg/PoseWithCovarianceStamped";
+inline constexpr const char* kPoseArrayType = "geometry_msgs/msg/PoseArray";
+inline constexpr const char* kPathType = "nav_msgs/msg/Path";
+inline constexpr const char* kOccupancyGridType = "nav_msgs/msg/OccupancyGrid";
 
 LaserScan DecodeLaserScan(const uint8_t* data, size_t size);
 Odometry DecodeOdometry(const uint8_t* data, size_t size);
@@ -105,6 +127,9 @@ std::vector<uint8_t> Encode(const Twist& m);
 std::vector<uint8_t> Encode(const TFMessage& m);
 std::vector<uint8_t> Encode(const PoseStamped& m);
 std::vector<uint8_t> Encode(const PoseWithCovarianceStamped& m);
+std::vector<uint8_t> Encode(const PoseArray& m);
+std::vector<uint8_t> Encode(const Path& m);
+std::vector<uint8_t> Encode(const OccupancyGrid& m);
 
 // A planar yaw from a quaternion, and back (the MBot's frames differ by yaw only).
 double Yaw(const Quaternion& q);

@@ -1,6 +1,8 @@
 // The ROS 2 transport's source and output types and their keys:
 //   source mcap     a ROS 2 bag: rosbag2 with storage mcap (the bag's folder, or one .mcap file), or
 //                   any MCAP file of ROS 2 messages (cdr), picked by the file's magic bytes;
+//   output rosbag2  records the run as a ROS 2 bag (run.mcap + metadata.yaml in the output folder);
+//                   [record] format = mcap on any config is this output;
 // ROS names are the pipeline's topics through a TopicTable (`topics`, with the MBot's names as
 // defaults: LIDAR:/scan, MBOT_ODOMETRY:/odom …); messages become events by their type.
 #pragma once
