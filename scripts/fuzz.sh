@@ -15,7 +15,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 targets=(lcm_log lcm_messages rawlog carmen botlab_map pgm_yaml gridmap simplemap movingai_map
-  movingai_scenarios motor_csv ini mcap cdr)
+  movingai_scenarios motor_csv ini mcap cdr ros1_bag)
 
 usage() { sed -n '2,5p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
 [ $# -ge 1 ] || usage
@@ -70,11 +70,15 @@ make_seeds() {
     movingai_scenarios)
       printf 'version 1\n0\ttiny.map\t8\t8\t0\t0\t7\t7\t9.89949494\n0\ttiny.map\t8\t8\t0\t7\t7\t0\t9.89949494\n' \
         > "$dir/seed_tiny" ;;
-    mcap | cdr)  # small bags of every message type, and each type's CDR, written by the target itself
+    mcap | cdr | ros1_bag)  # small bags of every message type, each type's CDR, ROS 1 bags of Intel's first messages
       local tmp=$build/fuzz/seeds/ros2_all
       rm -rf "$tmp" && mkdir -p "$tmp"
-      MBOT_FUZZ_SEED_DIR=$tmp "$build/tests/fuzz/fuzz_$t" -runs=0 "$tmp" > /dev/null 2>&1 || true
-      cp "$tmp"/seed_"$([ "$t" = mcap ] && echo bag || echo cdr)"* "$dir"/ 2>/dev/null || true ;;
+      MBOT_FUZZ_SEED_DIR=$tmp MBOT_FUZZ_ROS1_BAG=$datasets/carmen/intel.orig.bag \
+        "$build/tests/fuzz/fuzz_$t" -runs=0 "$tmp" > /dev/null 2>&1 || true
+      local prefix=bag
+      [ "$t" = cdr ] && prefix=cdr
+      [ "$t" = ros1_bag ] && prefix=ros1
+      cp "$tmp"/seed_"$prefix"* "$dir"/ 2>/dev/null || true ;;
     lcm_messages)
       MBOT_FUZZ_CARVE="$datasets/botlab/modern_small_logs/f23_lcmlog-2023-11-07.00:$datasets/botlab/modern_small_logs/w22_lcmlog-2022-02-14.04:$datasets/botlab/modern_small_logs/w25_mbot_square_log.log:$datasets/botlab/legacy_2017/sweep_drive_square_10mx10m_5cm.log:$datasets/botlab/legacy_2017/maebot_convex.log" \
         MBOT_FUZZ_CARVE_DIR=$dir "$build/tests/fuzz/fuzz_lcm_messages" -runs=0 "$dir" > /dev/null 2>&1 || true ;;

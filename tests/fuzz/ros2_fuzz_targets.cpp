@@ -1,8 +1,12 @@
 // libFuzzer targets of the ROS 2 transport's parsers (libs/ros2 only, so they build in a minute):
 //   mcap  a file given to the `mcap` source (McapReader, chunks, CRCs, every decoder, /tf_static);
-//   cdr   the first byte picks a message type, the rest is its CDR payload.
+//   cdr   the first byte picks a message type, the rest is its CDR payload;
+//   ros1_bag  a file given to the `ros1_bag` source (Ros1BagReader, bz2/lz4 chunks, ROS 1 decoders).
 // With MBOT_FUZZ_SEED_DIR set, LLVMFuzzerInitialize writes the seeds there first: small bags of
-// every message type (zstd-compressed and plain chunks) and each type's encoding (scripts/fuzz.sh).
+// every message type (zstd-compressed and plain chunks), each type's encoding, and ROS 1 bags
+// (uncompressed, bz2 and lz4 chunks) of the first messages of MBOT_FUZZ_ROS1_BAG (scripts/fuzz.sh).
+#include <bzlib.h>
+#include <lz4frame.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -11,6 +15,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -19,6 +24,7 @@
 #include "mbot/ros2/definitions.hpp"
 #include "mbot/ros2/mcap_writer.hpp"
 #include "mbot/ros2/messages.hpp"
+#include "mbot/ros2/ros1_bag.hpp"
 #include "mbot/ros2/ros2_transport.hpp"
 
 namespace {
@@ -89,6 +95,66 @@ void WriteSeeds(const fs::path& dir) {
   }
 }
 
+// ROS 1 bags of a real bag's first messages, one per chunk compression.
+std::string Ros1Field(const std::string& name, const std::string& value) {
+  const std::string f = name + "=" + value;
+  const uint32_t n = uint32_t(f.size());
+  return std::string(reinterpret_cast<const char*>(&n), 4) + f;
+}
+std::string Ros1U32(uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); }
+std::string Ros1Record(const std::string& header, const std::string& data) {
+  return Ros1U32(uint32_t(header.size())) + header + Ros1U32(uint32_t(data.size())) + data;
+}
+
+void WriteRos1Seeds(const fs::path& dir, const std::string& from) {
+  Ros1BagReader in(from);
+  McapMessage m;
+  std::map<uint32_t, int> taken;
+  std::string records;
+  for (int n = 0; n < 400 && in.Next(&m); ++n) {
+    if (taken[m.channel_id]++ >= 3) continue;
+    if (taken[m.channel_id] == 1) {
+      const Ros1Connection& c = in.connections().at(m.channel_id);
+      records += Ros1Record(Ros1Field("op", "\x07") + Ros1Field("conn", Ros1U32(c.id)) + Ros1Field("topic", c.topic),
+                            Ros1Field("topic", c.topic) + Ros1Field("type", c.type) + Ros1Field("md5sum", c.md5sum));
+    }
+    const std::string time =
+        Ros1U32(uint32_t(m.log_time_ns / 1000000000)) + Ros1U32(uint32_t(m.log_time_ns % 1000000000));
+    records += Ros1Record(Ros1Field("op", "\x02") + Ros1Field("conn", Ros1U32(m.channel_id)) + Ros1Field("time", time),
+                          std::string(m.data.begin(), m.data.end()));
+  }
+  for (const std::string compression : {"none", "bz2", "lz4"}) {
+    std::string packed = records;
+    if (compression == "bz2") {
+      packed.resize(records.size() + records.size() / 100 + 600);
+      unsigned int n = unsigned(packed.size());
+      BZ2_bzBuffToBuffCompress(packed.data(), &n, const_cast<char*>(records.data()), unsigned(records.size()), 9, 0, 0);
+      packed.resize(n);
+    } else if (compression == "lz4") {
+      packed.resize(LZ4F_compressFrameBound(records.size(), nullptr));
+      packed.resize(LZ4F_compressFrame(packed.data(), packed.size(), records.data(), records.size(), nullptr));
+    }
+    const std::string bag =
+        "#ROSBAG V2.0\n" + Ros1Record(Ros1Field("op", "\x05") + Ros1Field("compression", compression) +
+                                          Ros1Field("size", Ros1U32(uint32_t(records.size()))),
+                                      packed);
+    std::ofstream((dir / ("seed_ros1_" + compression)).string(), std::ios::binary)
+        .write(bag.data(), std::streamsize(bag.size()));
+  }
+}
+
+[[maybe_unused]] void Ros1(const uint8_t* d, size_t n) {
+  const std::string path = (Scratch() / "in.bag").string();
+  std::ofstream(path, std::ios::binary | std::ios::trunc)
+      .write(reinterpret_cast<const char*>(d), static_cast<std::streamsize>(n));
+  mbot::msgs::SourceOptions o;
+  o.type = "ros1_bag";
+  o.path = path;
+  auto source = mbot::msgs::OpenSource(o);
+  while (source->Next()) {
+  }
+}
+
 [[maybe_unused]] void Mcap(const uint8_t* d, size_t n) {
   const std::string path = (Scratch() / "in.mcap").string();
   std::ofstream(path, std::ios::binary | std::ios::trunc)
@@ -120,7 +186,10 @@ void WriteSeeds(const fs::path& dir) {
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   RegisterRos2Transport();
-  if (const char* dir = std::getenv("MBOT_FUZZ_SEED_DIR")) WriteSeeds(dir);
+  if (const char* dir = std::getenv("MBOT_FUZZ_SEED_DIR")) {
+    WriteSeeds(dir);
+    if (const char* bag = std::getenv("MBOT_FUZZ_ROS1_BAG")) WriteRos1Seeds(dir, bag);
+  }
   return 0;
 }
 

@@ -10,6 +10,8 @@
 2. The Intel log as a ROS 1 bag made by another project (carmen/intel.orig.bag), converted to a
    rosbag2 MCAP bag by rosbags-convert (zstd-compressed chunks), replays with every scan and every
    odometry message: the counts rosbags' own reader gives.
+3. Both Intel ROS 1 bags read directly (our ros1_bag source): rosbags' counts, and for the first
+   the same scans and odometry as through rosbags-convert's MCAP.
 
     bag_replay_test.py <mbot_nav> <config dir> <work dir>     (MBOT_DATASETS_DIR: the datasets)
 """
@@ -90,6 +92,35 @@ for topic, channel in (("/scan", "LIDAR"), ("/odom", "MBOT_ODOMETRY")):
     check(n == counts.get(topic), f"{topic}: {n} events from our source, {counts.get(topic)} messages by rosbags")
 check(inspected["rejected_messages"] == 0 and not inspected["truncated_tail"], "nothing rejected, no truncation")
 check(inspected["channels"]["LIDAR"]["beams_min"] == 180, "180 beams per Intel scan")
+
+# 3. The ROS 1 bags themselves (rosbag format 2.0, bz2 chunks), read by our ros1_bag source: every
+#    message rosbags' ROS 1 reader counts, and the same scans and odometry as the MCAP that
+#    rosbags-convert made of the same bag.
+from rosbags.rosbag1 import Reader as Ros1Reader  # noqa: E402
+
+for name in ("intel.orig.bag", "intel.clf2bag.bag"):
+    path = datasets / "carmen" / name
+    with Ros1Reader(path) as reader:
+        counts1 = {}
+        for c in reader.connections:
+            counts1[c.topic] = counts1.get(c.topic, 0) + c.msgcount
+    out = work / f"inspect_{name}"
+    run(["--config", config / "inspect.ini", "--set", f"source.path={path}", "--set", f"output.dir={out}"])
+    direct = json.loads((out / "inspect.json").read_text())
+    check(direct["format"] == "ROS 1 bag", f"{name}: read as a ROS 1 bag ({direct['format']})")
+    for topic, channel in (("/scan", "LIDAR"), ("/odom", "MBOT_ODOMETRY")):
+        n = direct["channels"].get(channel, {}).get("count")
+        check(n == counts1.get(topic), f"{name} {topic}: {n} events, {counts1.get(topic)} messages by rosbags")
+    check(direct["rejected_messages"] == 0 and not direct["truncated_tail"], f"{name}: nothing rejected, not cut")
+    if name == "intel.orig.bag":
+        for channel, keys in (("LIDAR", ("beams_min", "beams_max", "range_min_m", "range_max_m", "returns",
+                                         "no_returns", "first_s", "last_s")),
+                              ("MBOT_ODOMETRY", ("path_m", "first_s", "last_s"))):
+            a, b = direct["channels"][channel], inspected["channels"][channel]
+            same = all(a.get(k) == b.get(k) for k in keys)
+            check(same, f"{name} {channel}: the same as through rosbags-convert's MCAP "
+                        f"({', '.join(f'{k} {a.get(k)}' for k in keys)})")
+
 if failures:
     print(f"{len(failures)} check(s) failed")
     sys.exit(1)

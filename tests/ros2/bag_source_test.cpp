@@ -2,9 +2,11 @@
 // input — angle fields that disagree with the ranges, a /tf loop, an unknown schema, a CDR length
 // past the buffer, a file cut short — each a counted warning naming the topic, never a crash.
 // (Bags of writers we did not write: tests/ros2/bag_replay_test.py, recorder_interop.py.)
+#include <bzlib.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -13,6 +15,7 @@
 #include "mbot/ros2/mcap_reader.hpp"
 #include "mbot/ros2/mcap_writer.hpp"
 #include "mbot/ros2/messages.hpp"
+#include "mbot/ros2/ros1_bag.hpp"
 #include "mbot/ros2/ros2_transport.hpp"
 
 namespace mbot::ros2 {
@@ -239,6 +242,166 @@ TEST(Definitions, EveryRecordedTypeIsDefinedWithItsDependencies) {
                            kPoseWithCovarianceStampedType, kPoseArrayType, kPathType, kOccupancyGridType}) {
     EXPECT_NO_THROW(Definition(type)) << type;
   }
+}
+
+}  // namespace
+}  // namespace mbot::ros2
+
+namespace mbot::ros2 {
+namespace {
+
+// A ROS 1 bag written by hand (format 2.0): records of "name=value" header fields and data.
+struct Ros1Bag {
+  std::string bytes = "#ROSBAG V2.0\n";
+  static std::string Field(const std::string& name, const std::string& value) {
+    const std::string f = name + "=" + value;
+    const uint32_t n = uint32_t(f.size());
+    return std::string(reinterpret_cast<const char*>(&n), 4) + f;
+  }
+  static std::string U32(uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); }
+  static std::string Record(const std::string& header, const std::string& data) {
+    return U32(uint32_t(header.size())) + header + U32(uint32_t(data.size())) + data;
+  }
+  static std::string Connection(uint32_t id, const std::string& topic, const std::string& type) {
+    return Record(Field("op", "\x07") + Field("conn", U32(id)) + Field("topic", topic),
+                  Field("topic", topic) + Field("type", type) + Field("md5sum", "0"));
+  }
+  static std::string Message(uint32_t conn, uint32_t sec, const std::string& data) {
+    return Record(Field("op", "\x02") + Field("conn", U32(conn)) + Field("time", U32(sec) + U32(0)), data);
+  }
+};
+
+// ROS 1's Twist: six packed float64; its Odometry: a Header with seq, strings without NUL.
+std::string Ros1Twist(double vx, double wz) {
+  std::string s(48, '\0');
+  std::memcpy(&s[0], &vx, 8);
+  std::memcpy(&s[40], &wz, 8);
+  return s;
+}
+
+TEST(Ros1Bag, ReadsConnectionsAndMessagesInAndOutOfChunks) {
+  Ros1Bag b;
+  std::string chunk = Ros1Bag::Connection(0, "/cmd_vel", "geometry_msgs/Twist");
+  for (uint32_t t = 1; t <= 3; ++t) chunk += Ros1Bag::Message(0, 100 + t, Ros1Twist(0.1 * t, -0.5));
+  b.bytes += Ros1Bag::Record(Ros1Bag::Field("op", "\x05") + Ros1Bag::Field("compression", "none") +
+                                 Ros1Bag::Field("size", Ros1Bag::U32(uint32_t(chunk.size()))),
+                             chunk);
+  b.bytes += Ros1Bag::Message(0, 200, Ros1Twist(1.0, 0.25));  // outside a chunk, as old bags have them
+  const std::string path = TempPath("small.bag");
+  std::ofstream(path, std::ios::binary).write(b.bytes.data(), std::streamsize(b.bytes.size()));
+  ASSERT_EQ(msgs::DetectFormat(path), "ros1_bag");
+  msgs::SourceDiagnostics d;
+  const auto events = ReadAll(path, &d);
+  ASSERT_EQ(events.size(), 4u);
+  EXPECT_EQ(events[0].kind, msgs::EventKind::kMotorCommand);
+  EXPECT_EQ(events[0].t_us, 101'000'000);
+  EXPECT_NEAR(std::get<msgs::MotorCommand>(events[2].payload).velocity.v_m_s, 0.3, 1e-12);
+  EXPECT_EQ(std::get<msgs::MotorCommand>(events[3].payload).velocity.w_rad_s, 0.25);
+  EXPECT_FALSE(d.truncated_tail);
+  // Cut inside the last record: the three before it, and the cut said.
+  const std::string cut = TempPath("cut.bag");
+  std::ofstream(cut, std::ios::binary).write(b.bytes.data(), std::streamsize(b.bytes.size() - 10));
+  EXPECT_EQ(ReadAll(cut, &d).size(), 3u);
+  EXPECT_TRUE(d.truncated_tail);
+}
+
+TEST(Ros1Bag, ALyingChunkSizeOrAnUnknownConnectionIsRefusedNamingTheOffset) {
+  Ros1Bag b;
+  b.bytes += Ros1Bag::Record(Ros1Bag::Field("op", "\x05") + Ros1Bag::Field("compression", "bz2") +
+                                 Ros1Bag::Field("size", Ros1Bag::U32(0x7fffffff)),
+                             "BZh9 not really");
+  const std::string path = TempPath("lying.bag");
+  std::ofstream(path, std::ios::binary).write(b.bytes.data(), std::streamsize(b.bytes.size()));
+  Ros1BagReader r(path);
+  McapMessage m;
+  try {
+    r.Next(&m);
+    FAIL() << "a 2 GB chunk from 15 bytes was accepted";
+  } catch (const Ros1BagError& e) {
+    EXPECT_NE(std::string(e.what()).find("byte 13"), std::string::npos) << e.what();
+  }
+  Ros1Bag orphan;
+  orphan.bytes += Ros1Bag::Message(7, 1, Ros1Twist(0, 0));
+  std::ofstream(path, std::ios::binary | std::ios::trunc)
+      .write(orphan.bytes.data(), std::streamsize(orphan.bytes.size()));
+  Ros1BagReader r2(path);
+  EXPECT_THROW(r2.Next(&m), Ros1BagError);
+  EXPECT_THROW(Ros1BagReader(TempPath("small.mcap_missing")), Ros1BagError);
+}
+
+// bz2 holds no size of its own: a chunk claiming more than it holds (within the ratio bound) is
+// refused by what it decompresses to, and one claiming less by running past its claim.
+TEST(Ros1Bag, ABz2ChunkClaimingAnotherSizeIsRefused) {
+  std::string chunk = Ros1Bag::Connection(0, "/cmd_vel", "geometry_msgs/Twist");
+  for (uint32_t t = 0; t < 50; ++t) chunk += Ros1Bag::Message(0, t, Ros1Twist(t, 0));
+  std::string packed(chunk.size() + 1024, '\0');
+  unsigned int packed_size = unsigned(packed.size());
+  ASSERT_EQ(BZ2_bzBuffToBuffCompress(packed.data(), &packed_size, chunk.data(), unsigned(chunk.size()), 9, 0, 0),
+            BZ_OK);
+  packed.resize(packed_size);
+  for (const uint32_t claim : {uint32_t(chunk.size() * 20), uint32_t(chunk.size() / 2)}) {
+    Ros1Bag b;
+    b.bytes += Ros1Bag::Record(Ros1Bag::Field("op", "\x05") + Ros1Bag::Field("compression", "bz2") +
+                                   Ros1Bag::Field("size", Ros1Bag::U32(claim)),
+                               packed);
+    const std::string path = TempPath("bz2_claim.bag");
+    std::ofstream(path, std::ios::binary | std::ios::trunc).write(b.bytes.data(), std::streamsize(b.bytes.size()));
+    Ros1BagReader r(path);
+    McapMessage m;
+    try {
+      r.Next(&m);
+      FAIL() << "a bz2 chunk of " << chunk.size() << " bytes claiming " << claim << " was accepted";
+    } catch (const Ros1BagError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("bz2 chunk"), std::string::npos) << what;
+      EXPECT_NE(what.find("byte 13"), std::string::npos) << what;
+    }
+  }
+}
+
+// Chunks hold messages as they arrived, per topic: the reader gives them in time order (ties in file
+// order), and a bad chunk after good ones ends the bag only once the good ones are out.
+TEST(Ros1Bag, MessagesComeInTimeOrderAcrossChunksAndBeforeABadChunk) {
+  auto chunk_record = [](const std::string& chunk) {
+    return Ros1Bag::Record(Ros1Bag::Field("op", "\x05") + Ros1Bag::Field("compression", "none") +
+                               Ros1Bag::Field("size", Ros1Bag::U32(uint32_t(chunk.size()))),
+                           chunk);
+  };
+  Ros1Bag b;
+  std::string first = Ros1Bag::Connection(0, "/cmd_vel", "geometry_msgs/Twist");
+  for (uint32_t t : {10, 12, 11, 14}) first += Ros1Bag::Message(0, t, Ros1Twist(t, 0));
+  std::string second;
+  for (uint32_t t : {13, 15, 14}) second += Ros1Bag::Message(0, t, Ros1Twist(t + 0.5, 0));
+  b.bytes += chunk_record(first) + chunk_record(second);
+  const std::string path = TempPath("unsorted.bag");
+  std::ofstream(path, std::ios::binary).write(b.bytes.data(), std::streamsize(b.bytes.size()));
+  Ros1BagReader r(path);
+  McapMessage m;
+  std::vector<double> got;
+  while (r.Next(&m)) {
+    double vx;
+    std::memcpy(&vx, m.data.data(), 8);
+    got.push_back(vx);
+  }
+  EXPECT_EQ(got, (std::vector<double>{10, 11, 12, 13.5, 14, 14.5, 15.5}));
+  EXPECT_EQ(r.messages(), 7);
+
+  // The second chunk claims a compression nobody knows: the first chunk's four, then the error.
+  Ros1Bag bad;
+  bad.bytes +=
+      chunk_record(first) + Ros1Bag::Record(Ros1Bag::Field("op", "\x05") + Ros1Bag::Field("compression", "zip") +
+                                                Ros1Bag::Field("size", Ros1Bag::U32(4)),
+                                            "abcd");
+  std::ofstream(path, std::ios::binary | std::ios::trunc).write(bad.bytes.data(), std::streamsize(bad.bytes.size()));
+  Ros1BagReader r2(path);
+  int n = 0;
+  try {
+    while (r2.Next(&m)) ++n;
+    ADD_FAILURE() << "a chunk compressed with 'zip' was read";
+  } catch (const Ros1BagError& e) {
+    EXPECT_NE(std::string(e.what()).find("'zip'"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(n, 4);
 }
 
 }  // namespace

@@ -108,13 +108,27 @@ async function extras(page) {
   check(/^\d+ \/ \d+/.test(score), `the referee's score shown ("${score}")`);
   // Off and on measured back to back, once the page holds a distance grid (the map grows meanwhile).
   const haveDistances = await page.waitForFunction(() => window.mbotViewer.distances, { timeout: 5000 }).then(() => true).catch(() => false);
-  await sleep(200);
+  // Frames, not sleeps: a loaded machine draws few frames a second, and a pixel read between the
+  // click and the next frame sees the old picture.
+  const frames = (n) => page.evaluate(() => window.mbotViewer.framesDrawn)
+    .then((f0) => page.waitForFunction((f) => window.mbotViewer.framesDrawn >= f, { timeout: 10000 }, f0 + n))
+    .catch(() => {});
+  await frames(2);
   const withoutDistances = await orange();
   await page.click("#show_distances");
-  await sleep(300);
+  await frames(2);
   const withDistances = await orange();
+  const held = await page.evaluate(() => {
+    const d = window.mbotViewer.distances;
+    if (!d) return { tinted: 0, cells: 0 };
+    const b = atob(d.data);
+    let tinted = 0;
+    for (let i = 0; i < b.length; ++i) { const cm = b.charCodeAt(i); if (cm > 0 && cm < 50) ++tinted; }
+    return { tinted, cells: b.length, t: d.timestamp };
+  });
   check(haveDistances && withDistances.free < 0.7 * withoutDistances.free,
-        `obstacle distances drawn when asked (white free space ${withoutDistances.free} -> ${withDistances.free} px)`);
+        `obstacle distances drawn when asked (white free space ${withoutDistances.free} -> ${withDistances.free} px; ` +
+        `grid ${held.cells} cells, ${held.tinted} within 0.5 m of a wall)`);
   await page.click("#show_distances");
   const dir = join(dirname(reportPath), "downloads");
   mkdirSync(dir, { recursive: true });

@@ -145,10 +145,71 @@ std::optional<Transform> StaticTransforms::Lookup(const std::string& base, const
   return std::nullopt;
 }
 
+namespace {
+
+class McapFile : public BagFile {
+ public:
+  explicit McapFile(const std::string& path) : r_(path) {}
+  bool Next(McapMessage* m) override { return r_.Next(m); }
+  std::optional<ChannelDesc> Channel(uint16_t id) const override {
+    const auto ch = r_.channels().find(id);
+    if (ch == r_.channels().end()) return std::nullopt;
+    const auto schema = r_.schemas().find(ch->second.schema_id);
+    return ChannelDesc{ch->second.topic, schema != r_.schemas().end() ? schema->second.name : "",
+                       ch->second.message_encoding};
+  }
+  uint64_t position() const override { return r_.position(); }
+  long long messages() const override { return r_.stats().messages; }
+  long long chunks() const override { return r_.stats().chunks; }
+  long long crcs() const override { return r_.stats().crcs_checked; }
+  bool truncated() const override { return r_.stats().truncated; }
+
+ private:
+  McapReader r_;
+};
+
+class Ros1File : public BagFile {
+ public:
+  explicit Ros1File(const std::string& path) : r_(path) {}
+  bool Next(McapMessage* m) override { return r_.Next(m); }
+  std::optional<ChannelDesc> Channel(uint16_t id) const override {
+    const auto c = r_.connections().find(id);
+    if (c == r_.connections().end()) return std::nullopt;
+    // ROS 1 names types "pkg/Type"; the decoders know them by ROS 2's "pkg/msg/Type".
+    std::string type = c->second.type;
+    if (const size_t slash = type.find('/'); slash != std::string::npos && type.find("/msg/") == std::string::npos) {
+      type = type.substr(0, slash) + "/msg/" + type.substr(slash + 1);
+    }
+    return ChannelDesc{c->second.topic, type, "ros1"};
+  }
+  uint64_t position() const override { return r_.position(); }
+  long long messages() const override { return r_.messages(); }
+  long long chunks() const override { return r_.chunks(); }
+  long long crcs() const override { return 0; }  // ROS 1 bags have none
+  bool truncated() const override { return r_.truncated(); }
+
+ private:
+  Ros1BagReader r_;
+};
+
+bool HasRos1Magic(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  char head[13] = {};
+  in.read(head, 13);
+  return in.gcount() == 13 && std::string(head, 13) == "#ROSBAG V2.0\n";
+}
+
+}  // namespace
+
+std::unique_ptr<BagFile> OpenBagFile(const std::string& path) {
+  if (HasRos1Magic(path)) return std::make_unique<Ros1File>(path);
+  return std::make_unique<McapFile>(path);
+}
+
 std::vector<std::string> BagFiles(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  if (!fs::is_directory(path, ec)) return {path};
+  if (!fs::is_directory(path, ec)) return {path};  // a .mcap or a ROS 1 .bag
   std::vector<std::string> files = MetadataFiles(path);
   if (files.empty()) {
     for (const auto& entry : fs::directory_iterator(path, ec)) {
@@ -170,7 +231,8 @@ McapBagSource::McapBagSource(const msgs::SourceOptions& options)
     : options_(options), bag_(msgs::ExtraOr<BagSourceOptions>(options)), files_(BagFiles(options.path)) {
   std::error_code ec;
   for (const std::string& f : files_) bytes_total_ += std::filesystem::file_size(f, ec);
-  reader_ = std::make_unique<McapReader>(files_[0]);
+  ros1_ = HasRos1Magic(files_[0]);
+  reader_ = OpenBagFile(files_[0]);
 }
 
 double McapBagSource::Progress() const {
@@ -181,9 +243,9 @@ double McapBagSource::Progress() const {
 std::vector<std::pair<std::string, std::string>> McapBagSource::Details() const {
   std::vector<std::pair<std::string, std::string>> d = {
       {"files", std::to_string(files_.size())},
-      {"messages", std::to_string(messages_ + (reader_ ? reader_->stats().messages : 0))},
-      {"chunks", std::to_string(chunks_ + (reader_ ? reader_->stats().chunks : 0))},
-      {"CRCs checked", std::to_string(crcs_ + (reader_ ? reader_->stats().crcs_checked : 0))}};
+      {"messages", std::to_string(messages_ + (reader_ ? reader_->messages() : 0))},
+      {"chunks", std::to_string(chunks_ + (reader_ ? reader_->chunks() : 0))},
+      {"CRCs checked", std::to_string(crcs_ + (reader_ ? reader_->crcs() : 0))}};
   for (const auto& [frame, m] : mounts_) {
     char text[160];
     std::snprintf(text, sizeof text, "x %.3f m, y %.3f m, yaw %.1f deg%s (from /tf_static)", m.pose.x, m.pose.y,
@@ -199,7 +261,7 @@ bool McapBagSource::ReadMore() {
     bool got = false;
     try {
       got = reader_->Next(&m);
-    } catch (const McapError& e) {
+    } catch (const std::runtime_error& e) {  // McapError, Ros1BagError
       // What came before the damage was read; the rest of this file cannot be trusted.
       mbot::log::Warn(std::string(e.what()) + " (the file's messages up to there were replayed)");
       diagnostics_.truncated_tail = true;
@@ -209,15 +271,15 @@ bool McapBagSource::ReadMore() {
       Handle(m);
       return true;
     }
-    if (reader_->stats().truncated) diagnostics_.truncated_tail = true;
-    messages_ += reader_->stats().messages;
-    chunks_ += reader_->stats().chunks;
-    crcs_ += reader_->stats().crcs_checked;
+    if (reader_->truncated()) diagnostics_.truncated_tail = true;
+    messages_ += reader_->messages();
+    chunks_ += reader_->chunks();
+    crcs_ += reader_->crcs();
     std::error_code ec;
     bytes_before_ += std::filesystem::file_size(files_[file_index_], ec);
     reader_.reset();
     routes_.clear();  // channel ids are per file
-    if (++file_index_ < files_.size()) reader_ = std::make_unique<McapReader>(files_[file_index_]);
+    if (++file_index_ < files_.size()) reader_ = OpenBagFile(files_[file_index_]);
   }
   return false;
 }
@@ -307,15 +369,14 @@ bool McapBagSource::LidarEvent(const LaserScan& s, const std::string& topic, Eve
 McapBagSource::Route McapBagSource::RouteOf(uint16_t channel_id) {
   // Once per channel of each file: what its messages are, under which topic.
   Route r;
-  const auto ch = reader_->channels().find(channel_id);
-  if (ch == reader_->channels().end()) return r;  // the reader checks that a message's channel came first
-  r.wire = ch->second.topic;
-  const auto schema = reader_->schemas().find(ch->second.schema_id);
-  const std::string type = schema != reader_->schemas().end() ? schema->second.name : "";
+  const std::optional<BagFile::ChannelDesc> ch = reader_->Channel(channel_id);
+  if (!ch) return r;  // the reader checks that a message's channel came first
+  r.wire = ch->topic;
+  const std::string type = ch->type;
   r.topic = bag_.topics.Topic(r.wire);
   msgs::ChannelInfo& info = channels_[r.topic];  // keyed by the pipeline's topic, as the events are
   info.type = type;
-  info.generation = "ROS 2 " + r.wire + " (" + ch->second.message_encoding + ")";
+  info.generation = std::string(ch->encoding == "ros1" ? "ROS 1 " : "ROS 2 ") + r.wire + " (" + ch->encoding + ")";
   r.info = &info;
   const std::pair<const char*, Route::Type> types[] = {{kLaserScanType, Route::kScan},
                                                        {kOdometryType, Route::kOdometry},
@@ -327,11 +388,12 @@ McapBagSource::Route McapBagSource::RouteOf(uint16_t channel_id) {
   for (const auto& [name, t] : types) {
     if (type == name) r.type = t;
   }
-  if (ch->second.message_encoding != "cdr") r.type = Route::kUnknown;
+  if (ch->encoding == "ros1") r.serialization = Serialization::kRos1;
+  if (ch->encoding != "cdr" && ch->encoding != "ros1") r.type = Route::kUnknown;
   if (r.type == Route::kUnknown) {
     info.decoded = false;
     mbot::log::Warn(files_[file_index_] + ": topic " + r.wire + " carries " + (type.empty() ? "no schema" : type) +
-                    " (" + ch->second.message_encoding +
+                    " (" + ch->encoding +
                     "), which this reader does not decode; its messages are "
                     "skipped");
   }
@@ -366,15 +428,15 @@ void McapBagSource::Handle(const McapMessage& m) {
   const size_t size = m.data.size();
   try {
     if (route.type == Route::kScan) {
-      if (!LidarEvent(DecodeLaserScan(d, size), wire, &ev)) return;
+      if (!LidarEvent(DecodeLaserScan(d, size, route.serialization), wire, &ev)) return;
     } else if (route.type == Route::kOdometry) {
-      const Odometry o = DecodeOdometry(d, size);
+      const Odometry o = DecodeOdometry(d, size, route.serialization);
       if (odom_child_frame_.empty() && !o.child_frame_id.empty()) odom_child_frame_ = o.child_frame_id;
       ev.kind = EventKind::kOdometry;
       ev.stamp_us = StampUs(o.header.stamp);
       ev.payload = Planar(o.pose);
     } else if (route.type == Route::kImu) {
-      const Imu i = DecodeImu(d, size);
+      const Imu i = DecodeImu(d, size, route.serialization);
       msgs::Imu imu;
       imu.gyro_rad_s[0] = i.angular_velocity.x, imu.gyro_rad_s[1] = i.angular_velocity.y;
       imu.gyro_rad_s[2] = i.angular_velocity.z;
@@ -392,12 +454,12 @@ void McapBagSource::Handle(const McapMessage& m) {
       ev.stamp_us = StampUs(i.header.stamp);
       ev.payload = imu;
     } else if (route.type == Route::kTwist) {
-      const Twist t = DecodeTwist(d, size);
+      const Twist t = DecodeTwist(d, size, route.serialization);
       ev.kind = EventKind::kMotorCommand;
       ev.stamp_us = t_us;
       ev.payload = msgs::MotorCommand::Velocity(t.linear.x, t.angular.z);
     } else if (route.type == Route::kTf) {  // /tf_static
-      const std::string refused = tf_static_.Add(DecodeTFMessage(d, size));
+      const std::string refused = tf_static_.Add(DecodeTFMessage(d, size, route.serialization));
       mounts_.clear();
       if (!refused.empty()) {
         ++diagnostics_.rejected_messages;
@@ -408,10 +470,10 @@ void McapBagSource::Handle(const McapMessage& m) {
     } else {  // PoseStamped, PoseWithCovarianceStamped: the pose role of the topic
       Pose2D pose;
       if (route.type == Route::kPoseStamped) {
-        const PoseStamped p = DecodePoseStamped(d, size);
+        const PoseStamped p = DecodePoseStamped(d, size, route.serialization);
         pose = Planar(p.pose), ev.stamp_us = StampUs(p.header.stamp);
       } else {
-        const PoseWithCovarianceStamped p = DecodePoseWithCovarianceStamped(d, size);
+        const PoseWithCovarianceStamped p = DecodePoseWithCovarianceStamped(d, size, route.serialization);
         pose = Planar(p.pose), ev.stamp_us = StampUs(p.header.stamp);
       }
       const msgs::ChannelRoles& roles = options_.roles;

@@ -14,6 +14,7 @@ CdrReader::CdrReader(const uint8_t* data, size_t size) : data_(data), size_(size
 }
 
 void CdrReader::Align(size_t n) {
+  if (ros1_) return;  // ROS 1 packs its fields
   const size_t rel = pos_ - 4;
   const size_t pad = (n - rel % n) % n;
   pos_ = pos_ + pad > size_ ? size_ : pos_ + pad;
@@ -23,7 +24,7 @@ const uint8_t* CdrReader::Take(size_t n, const char* field) {
   if (n > size_ - pos_) {
     throw CdrError(std::string("CDR: ") + field + " needs " + std::to_string(n) + " bytes, " +
                        std::to_string(size_ - pos_) + " left",
-                   pos_ - 4);
+                   pos_ - start_);
   }
   const uint8_t* p = data_ + pos_;
   pos_ += n;
@@ -59,6 +60,7 @@ std::string CdrReader::String(const char* f) {
   const uint32_t n = U32(f);
   if (n == 0) return {};  // some writers send 0 for an empty string
   const uint8_t* p = Take(n, f);
+  if (ros1_) return std::string(reinterpret_cast<const char*>(p), n);
   if (p[n - 1] != 0) throw CdrError(std::string("CDR: ") + f + " is a string without its NUL", at);
   return std::string(reinterpret_cast<const char*>(p), n - 1);
 }

@@ -6,8 +6,13 @@ namespace mbot::ros2 {
 
 namespace {
 
+CdrReader Reader(const uint8_t* data, size_t size, Serialization s) {
+  return s == Serialization::kRos1 ? CdrReader(CdrReader::Ros1{}, data, size) : CdrReader(data, size);
+}
+
 Header ReadHeader(CdrReader& r) {
   Header h;
+  if (r.ros1()) r.U32("header.seq");  // ROS 1's Header starts with a sequence number
   h.stamp.sec = r.I32("header.stamp.sec");
   h.stamp.nanosec = r.U32("header.stamp.nanosec");
   h.frame_id = r.String("header.frame_id");
@@ -40,8 +45,8 @@ void WriteTwist(CdrWriter& w, const Twist& t) { WriteVector3(w, t.linear), Write
 
 }  // namespace
 
-LaserScan DecodeLaserScan(const uint8_t* data, size_t size) {
-  CdrReader r(data, size);
+LaserScan DecodeLaserScan(const uint8_t* data, size_t size, Serialization serialization) {
+  CdrReader r = Reader(data, size, serialization);
   LaserScan m;
   m.header = ReadHeader(r);
   m.angle_min = r.F32("angle_min");
@@ -56,8 +61,8 @@ LaserScan DecodeLaserScan(const uint8_t* data, size_t size) {
   return m;
 }
 
-Odometry DecodeOdometry(const uint8_t* data, size_t size) {
-  CdrReader r(data, size);
+Odometry DecodeOdometry(const uint8_t* data, size_t size, Serialization serialization) {
+  CdrReader r = Reader(data, size, serialization);
   Odometry m;
   m.header = ReadHeader(r);
   m.child_frame_id = r.String("child_frame_id");
@@ -69,8 +74,8 @@ Odometry DecodeOdometry(const uint8_t* data, size_t size) {
   return m;
 }
 
-Imu DecodeImu(const uint8_t* data, size_t size) {
-  CdrReader r(data, size);
+Imu DecodeImu(const uint8_t* data, size_t size, Serialization serialization) {
+  CdrReader r = Reader(data, size, serialization);
   Imu m;
   m.header = ReadHeader(r);
   m.orientation = ReadQuaternion(r, "orientation");
@@ -82,13 +87,13 @@ Imu DecodeImu(const uint8_t* data, size_t size) {
   return m;
 }
 
-Twist DecodeTwist(const uint8_t* data, size_t size) {
-  CdrReader r(data, size);
+Twist DecodeTwist(const uint8_t* data, size_t size, Serialization serialization) {
+  CdrReader r = Reader(data, size, serialization);
   return ReadTwist(r);
 }
 
-TFMessage DecodeTFMessage(const uint8_t* data, size_t size) {
-  CdrReader r(data, size);
+TFMessage DecodeTFMessage(const uint8_t* data, size_t size, Serialization serialization) {
+  CdrReader r = Reader(data, size, serialization);
   TFMessage m;
   // A transform takes at least 4 + 8 (stamp, an empty frame) + 4 (child) + 56 bytes.
   const uint32_t n = r.Count("transforms", 72);
@@ -102,8 +107,8 @@ TFMessage DecodeTFMessage(const uint8_t* data, size_t size) {
   return m;
 }
 
-PoseStamped DecodePoseStamped(const uint8_t* data, size_t size) {
-  CdrReader r(data, size);
+PoseStamped DecodePoseStamped(const uint8_t* data, size_t size, Serialization serialization) {
+  CdrReader r = Reader(data, size, serialization);
   PoseStamped m;
   m.header = ReadHeader(r);
   m.pose.position = ReadVector3(r, "pose.position");
@@ -111,8 +116,9 @@ PoseStamped DecodePoseStamped(const uint8_t* data, size_t size) {
   return m;
 }
 
-PoseWithCovarianceStamped DecodePoseWithCovarianceStamped(const uint8_t* data, size_t size) {
-  CdrReader r(data, size);
+PoseWithCovarianceStamped DecodePoseWithCovarianceStamped(const uint8_t* data, size_t size,
+                                                          Serialization serialization) {
+  CdrReader r = Reader(data, size, serialization);
   PoseWithCovarianceStamped m;
   m.header = ReadHeader(r);
   m.pose.position = ReadVector3(r, "pose.pose.position");

@@ -48,6 +48,13 @@ bool IsMcapBag(const std::string& path) {
   return in.gcount() == 8 && std::memcmp(head, "\x89MCAP0\r\n", 8) == 0;
 }
 
+bool IsRos1Bag(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char head[13] = {};
+  in.read(head, 13);
+  return in.gcount() == 13 && std::memcmp(head, "#ROSBAG V2.0\n", 13) == 0;
+}
+
 void ParseBagOptions(config::Section& s, msgs::SourceOptions* o) {
   ParseChannelRoles(s, &o->roles);
   BagSourceOptions b;
@@ -73,6 +80,11 @@ void RegisterRos2Transport() {
                             ParseBagOptions,
                             [](const msgs::SourceOptions& o) { return std::make_unique<McapBagSource>(o); },
                             msgs::SourceType::Path::kFileOrFolder});
+  msgs::RegisterSourceType({"ros1_bag",
+                            "a ROS 1 bag (format 2.0; chunks plain, bz2 or lz4), as most public 2D SLAM data ships: "
+                            "the same topics and keys as mcap",
+                            IsRos1Bag, 10, ParseBagOptions,
+                            [](const msgs::SourceOptions& o) { return std::make_unique<McapBagSource>(o); }});
   msgs::OutputType recorder;
   recorder.name = "rosbag2";
   recorder.doc =

@@ -29,6 +29,11 @@ class CdrReader {
  public:
   // `data` starts with the encapsulation header; big-endian CDR is refused (ROS 2 writes little).
   CdrReader(const uint8_t* data, size_t size);
+  // ROS 1's serialization instead (a ROS 1 bag's messages): the same fields, little-endian, with no
+  // header, no alignment, and strings without their NUL.
+  struct Ros1 {};
+  CdrReader(Ros1, const uint8_t* data, size_t size) : data_(data), size_(size), pos_(0), start_(0), ros1_(true) {}
+  bool ros1() const { return ros1_; }
 
   uint8_t U8(const char* field);
   bool Bool(const char* field);
@@ -47,14 +52,15 @@ class CdrReader {
   std::vector<int8_t> I8s(const char* field);
   void F64Array(const char* field, double* out, size_t n);  // a fixed array (float64[36] …)
 
-  size_t offset() const { return pos_ - 4; }  // in the payload, after the header
+  size_t offset() const { return pos_ - start_; }  // in the payload, after the header
   size_t remaining() const { return size_ - pos_; }
 
  private:
   void Align(size_t n);
   const uint8_t* Take(size_t n, const char* field);
   const uint8_t* data_;
-  size_t size_, pos_ = 4;
+  size_t size_, pos_ = 4, start_ = 4;
+  bool ros1_ = false;
 };
 
 class CdrWriter {

@@ -112,13 +112,17 @@ inline constexpr const char* kPoseArrayType = "geometry_msgs/msg/PoseArray";
 inline constexpr const char* kPathType = "nav_msgs/msg/Path";
 inline constexpr const char* kOccupancyGridType = "nav_msgs/msg/OccupancyGrid";
 
-LaserScan DecodeLaserScan(const uint8_t* data, size_t size);
-Odometry DecodeOdometry(const uint8_t* data, size_t size);
-Imu DecodeImu(const uint8_t* data, size_t size);
-Twist DecodeTwist(const uint8_t* data, size_t size);
-TFMessage DecodeTFMessage(const uint8_t* data, size_t size);
-PoseStamped DecodePoseStamped(const uint8_t* data, size_t size);
-PoseWithCovarianceStamped DecodePoseWithCovarianceStamped(const uint8_t* data, size_t size);
+// How a payload is serialized: ROS 2's CDR, or ROS 1's (a ROS 1 bag: packed, Header with seq).
+enum class Serialization { kCdr, kRos1 };
+
+LaserScan DecodeLaserScan(const uint8_t* data, size_t size, Serialization s = Serialization::kCdr);
+Odometry DecodeOdometry(const uint8_t* data, size_t size, Serialization s = Serialization::kCdr);
+Imu DecodeImu(const uint8_t* data, size_t size, Serialization s = Serialization::kCdr);
+Twist DecodeTwist(const uint8_t* data, size_t size, Serialization s = Serialization::kCdr);
+TFMessage DecodeTFMessage(const uint8_t* data, size_t size, Serialization s = Serialization::kCdr);
+PoseStamped DecodePoseStamped(const uint8_t* data, size_t size, Serialization s = Serialization::kCdr);
+PoseWithCovarianceStamped DecodePoseWithCovarianceStamped(const uint8_t* data, size_t size,
+                                                          Serialization s = Serialization::kCdr);
 
 std::vector<uint8_t> Encode(const LaserScan& m);
 std::vector<uint8_t> Encode(const Odometry& m);
