@@ -1,10 +1,11 @@
 #include "mbot/ros2/mcap_reader.hpp"
 
-#include <lz4frame.h>
 #include <zlib.h>
 #include <zstd.h>
 
 #include <cstring>
+
+#include "lz4_frame.hpp"
 
 namespace mbot::ros2 {
 
@@ -255,7 +256,8 @@ void McapReader::ReadChunk(const uint8_t* data, uint64_t size, uint64_t offset) 
       Fail("a zstd chunk whose frame holds " + std::to_string(frame) + " bytes, not its " + std::to_string(usize),
            offset);
   }
-  chunk_.resize(usize);  // every byte is written below (or the chunk refused): no need to clear it
+  // every byte is written below (or the chunk refused): no need to clear it; lz4 grows its own
+  if (compression != "lz4") chunk_.resize(usize);
   if (compression.empty()) {
     if (csize != usize) Fail("an uncompressed chunk whose sizes differ", offset);
     if (usize) std::memcpy(chunk_.data(), src, usize);
@@ -265,22 +267,10 @@ void McapReader::ReadChunk(const uint8_t* data, uint64_t size, uint64_t offset) 
     if (r != usize)
       Fail("a zstd chunk decompresses to " + std::to_string(r) + " bytes, not " + std::to_string(usize), offset);
   } else if (compression == "lz4") {  // an LZ4 frame
-    LZ4F_dctx* ctx = nullptr;
-    if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION))) Fail("lz4: no context", offset);
-    size_t out = 0, in = 0, hint = 1;
-    while (hint != 0 && in < csize) {
-      size_t dst = usize - out, n = csize - in;
-      hint = LZ4F_decompress(ctx, chunk_.data() + out, &dst, src + in, &n, nullptr);
-      if (LZ4F_isError(hint)) {
-        LZ4F_freeDecompressionContext(ctx);
-        Fail(std::string("an lz4 chunk does not decompress: ") + LZ4F_getErrorName(hint), offset);
-      }
-      out += dst, in += n;
-      if (dst == 0 && n == 0) break;
-    }
-    LZ4F_freeDecompressionContext(ctx);
-    if (hint != 0 || out != usize)
-      Fail("an lz4 chunk decompresses to " + std::to_string(out) + " bytes, not " + std::to_string(usize), offset);
+    const Lz4FrameResult r = DecompressLz4Frame(src, csize, usize, &chunk_);
+    if (!r.error.empty()) Fail("an lz4 chunk does not decompress: " + r.error, offset);
+    if (!r.ended || r.size != usize)
+      Fail("an lz4 chunk decompresses to " + std::to_string(r.size) + " bytes, not " + std::to_string(usize), offset);
   } else {
     Fail("a chunk compressed with '" + compression + "' (known: none, zstd, lz4)", offset);
   }

@@ -1,11 +1,12 @@
 #include "mbot/ros2/ros1_bag.hpp"
 
 #include <bzlib.h>
-#include <lz4frame.h>
 
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
+
+#include "lz4_frame.hpp"
 
 namespace mbot::ros2 {
 
@@ -310,21 +311,9 @@ void Ros1BagReader::ReadChunk(const std::map<std::string, std::string>& h, const
     if (out != usize)
       Fail("a bz2 chunk decompresses to " + std::to_string(out) + " bytes, not " + std::to_string(usize), offset);
   } else if (compression == "lz4") {
-    LZ4F_dctx* ctx = nullptr;
-    if (LZ4F_isError(LZ4F_createDecompressionContext(&ctx, LZ4F_VERSION))) Fail("lz4: no context", offset);
-    size_t in = 0, hint = 1;
-    while (hint != 0 && in < size) {
-      size_t dst = room(), n = size - in;
-      if (dst == 0) break;
-      hint = LZ4F_decompress(ctx, chunk_.data() + out, &dst, data + in, &n, nullptr);
-      if (LZ4F_isError(hint)) {
-        LZ4F_freeDecompressionContext(ctx);
-        Fail(std::string("an lz4 chunk does not decompress: ") + LZ4F_getErrorName(hint), offset);
-      }
-      out += dst, in += n;
-      if (dst == 0 && n == 0) break;
-    }
-    LZ4F_freeDecompressionContext(ctx);
+    const Lz4FrameResult r = DecompressLz4Frame(data, size, usize, &chunk_);
+    if (!r.error.empty()) Fail("an lz4 chunk does not decompress: " + r.error, offset);
+    out = r.size;
     if (out != usize)
       Fail("an lz4 chunk decompresses to " + std::to_string(out) + " bytes, not " + std::to_string(usize), offset);
   } else {
