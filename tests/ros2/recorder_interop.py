@@ -23,7 +23,7 @@ from pathlib import Path
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 from rosbags.highlevel import AnyReader
-from rosbags.typesys import Stores, get_typestore
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from ruamel.yaml import YAML
 
 mbot_nav, config, work = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])
@@ -57,6 +57,9 @@ def open_with_foxglove(bag):
 
 def open_with_rosbags(bag):
     ts = get_typestore(Stores.ROS2_JAZZY)
+    # The MBot's own message, from mbot_interfaces/msg/Encoders.msg of the firmware's generation.
+    ts.register(get_types_from_msg("builtin_interfaces/Time stamp\nint64[3] ticks\nint32[3] delta_ticks\n"
+                                   "int32 delta_time\n", "mbot_interfaces/msg/Encoders"))
     counts, last, qos = {}, {}, {}
     with AnyReader([bag], default_typestore=ts) as reader:
         for connection, _t, raw in reader.messages():
@@ -143,6 +146,21 @@ if (sim / "run.mcap").exists():
     _h, s2, c2, _l, _m = open_with_foxglove(sim)
     check(sum(c2.values()) > 0 and s2.statistics.message_count == sum(c2.values()),
           f"the interrupted bag is whole: {sum(c2.values())} messages, CRCs valid")
+    # The exploration's own topics, decoded by rosbags' Jazzy types as well.
+    r2, last2, _q2 = open_with_rosbags(sim)
+    print("topics:", ", ".join(f"{t} {n}" for t, n in sorted(r2.items())))
+    check(r2 == c2, "rosbags and Foxglove's reader read the same messages of the exploration")
+    for topic, msgtype in (("/frontier_markers", "visualization_msgs/msg/MarkerArray"),
+                           ("/mission_state", "std_msgs/msg/String"), ("/planned_path", "nav_msgs/msg/Path"),
+                           ("/encoders", "mbot_interfaces/msg/Encoders")):
+        check(r2.get(topic, 0) > 0, f"{topic} recorded ({r2.get(topic, 0)}, {msgtype})")
+    if "/frontier_markers" in last2:
+        markers = last2["/frontier_markers"].markers
+        check(markers and markers[0].action == 3 and all(m.type == 8 and len(m.points) > 0 for m in markers[1:]),
+              f"/frontier_markers: a DELETEALL, then POINTS markers ({len(markers) - 1} regions)")
+    if "/mission_state" in last2:
+        check(last2["/mission_state"].data.split(":")[0] in ("initializing", "exploring", "returning_home"),
+              f"/mission_state says {last2['/mission_state'].data!r}")
 if failures:
     print(f"{len(failures)} check(s) failed")
     sys.exit(1)

@@ -22,11 +22,6 @@ std::string LcmChannelPattern(const std::string& channel) {
   return exact;
 }
 
-int64_t WallClockUs() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
 struct LcmNode::Impl {
   lcm::LCM lcm;
   std::vector<Event>* sink = nullptr;  // where the handler puts decoded events during Poll

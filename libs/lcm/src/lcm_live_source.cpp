@@ -1,144 +1,45 @@
 #include "lcm_live_source.hpp"
 
-#include <algorithm>
-#include <sstream>
-
 #include "mbot/common/log.hpp"
+#include "mbot/lcm/lcm_live.hpp"
 
 namespace mbot::lcmio {
 
 using namespace msgs;  // the event vocabulary
 namespace {
 
-std::string Fixed(double v, int digits) {
-  std::ostringstream s;
-  s.setf(std::ios::fixed);
-  s.precision(digits);
-  s << v;
-  return s.str();
-}
+class LcmLink : public LiveLink {
+ public:
+  LcmLink(const std::string& url, const std::vector<std::string>& channels, const ChannelRoles& roles)
+      : node_(url, channels, roles) {}
+  void Poll(int timeout_ms, std::vector<Event>* out) override { node_.Poll(timeout_ms, out); }
+  bool Publish(const Event& event) override { return node_.Publish(event); }
+  long long rejected_total() const override { return node_.rejected_total(); }
+  std::string name() const override { return "lcm"; }
+  std::string where() const override { return node_.url(); }
+  ChannelInfo Describe(const std::string& /*channel*/) const override {
+    return ChannelInfo{"mbot_lcm_msgs", "2023+", EventKind::kOther, true};
+  }
+  std::vector<std::pair<std::string, std::string>> Details() const override {
+    std::vector<std::pair<std::string, std::string>> d;
+    for (const auto& [channel, s] : node_.stats()) {
+      if (s.rejected + s.unknown > 0)
+        d.push_back({"rejected on " + channel, std::to_string(s.rejected + s.unknown) + " (" + s.last_error + ")"});
+      if (s.own_echoes > 0) d.push_back({"own messages looped back on " + channel, std::to_string(s.own_echoes)});
+    }
+    return d;
+  }
+
+ private:
+  LcmNode node_;
+};
 
 }  // namespace
 
-LcmLiveSource::LcmLiveSource(const SourceOptions& options)
-    : o_(ExtraOr<LiveSourceOptions>(options)),
-      node_(options.path, o_.channels, options.roles),
-      watchdog_(o_.watched, o_.stale_sensor_s, 0.0, kZeroRateHz) {
-  start_ = last_message_ = last_report_ = Clock::now();
-  for (const std::string& c : o_.channels)
-    channels_[c] = ChannelInfo{"mbot_lcm_msgs", "2023+", EventKind::kOther, true};
-  mbot::log::Info("lcm: listening on " + options.path + " to " + std::to_string(o_.channels.size()) + " channels");
-}
-
-std::optional<Event> LcmLiveSource::Next() {
-  for (;;) {
-    const Clock::time_point now = Clock::now();  // intervals on the steady clock: a wall-clock step cannot fool them
-    if (o_.duration_s > 0 && now - start_ >= Seconds(o_.duration_s)) {
-      Report(now, true);
-      return std::nullopt;
-    }
-    if (o_.end_after_silence_s > 0 && now - last_message_ >= Seconds(o_.end_after_silence_s)) {
-      mbot::log::Info("lcm: nothing arrived for " + Fixed(o_.end_after_silence_s, 1) + " s: ending the run");
-      Report(now, true);
-      return std::nullopt;
-    }
-    // Take what is waiting first, so a newer scan behind the queue is seen before an older one is
-    // processed.
-    std::vector<Event> got;
-    node_.Poll(queue_.empty() ? 50 : 0, &got);
-    diagnostics_.rejected_messages = node_.rejected_total();
-    for (Event& e : got) {
-      last_message_ = Clock::now();
-      watchdog_.Heard(e.channel, SecondsSinceStart(last_message_));
-      channels_[e.channel].kind = e.kind;
-      queue_.push_back(std::move(e));
-    }
-    Watchdog(Clock::now());
-    Report(Clock::now(), false);
-    if (queue_.empty()) {
-      const int64_t t = WallClockUs();
-      return Event{t, t, "LIVE_TICK", EventKind::kOther, {}};  // lets the pipeline check its stop flag
-    }
-    Event ev = std::move(queue_.front());
-    queue_.pop_front();
-    // A scan overtaken by a newer one is stale: drop it rather than fall behind.
-    if (ev.kind == EventKind::kLidar &&
-        std::any_of(queue_.begin(), queue_.end(), [](const Event& e) { return e.kind == EventKind::kLidar; })) {
-      ++dropped_scans_;
-      continue;
-    }
-    latency_ms_.push_back((WallClockUs() - ev.t_us) * 1e-3);
-    if (latency_ms_.size() >= kMaxLatencySamples) Report(Clock::now(), true);
-    ++delivered_;
-    return ev;
-  }
-}
-
-void LcmLiveSource::Watchdog(Clock::time_point now) {
-  const double t_s = SecondsSinceStart(now);
-  switch (watchdog_.Check(t_s)) {
-    case SensorWatchdog::Change::kHalted:
-      mbot::log::Warn("lcm: no " + watchdog_.silent() + " for " + Fixed(o_.stale_sensor_s, 1) +
-                      " s: robot stopped (zero velocity on " + o_.command_channel + ") until it is back");
-      break;
-    case SensorWatchdog::Change::kResumed: mbot::log::Info("lcm: sensors back: commands pass again"); break;
-    case SensorWatchdog::Change::kNone: break;
-  }
-  if (watchdog_.ZeroDue(t_s)) {
-    const int64_t t = WallClockUs();
-    node_.Publish(Event{t, t, o_.command_channel, EventKind::kMotorCommand, MotorCommand::Velocity(0, 0)});
-  }
-}
-
-void LcmLiveSource::Send(const Event& event) {
-  Event out = watchdog_.Filter(event, o_.command_channel);
-  if (out.stamp_us == 0) out.stamp_us = WallClockUs();
-  node_.Publish(out);
-}
-
-void LcmLiveSource::Report(Clock::time_point now, bool force) {
-  const bool due = o_.report_every_s > 0 && now - last_report_ >= Seconds(o_.report_every_s);
-  if (!force && !due) return;
-  const double span_s = std::chrono::duration<double>(now - last_report_).count();
-  last_rate_hz_ = span_s > 0 ? (delivered_ - delivered_at_report_) / span_s : 0.0;
-  if (!latency_ms_.empty()) {
-    std::sort(latency_ms_.begin(), latency_ms_.end());
-    last_latency_median_ms_ = latency_ms_[latency_ms_.size() / 2];
-    last_latency_max_ms_ = latency_ms_.back();
-  }
-  if (o_.report_every_s > 0) {
-    mbot::log::Info("lcm: " + Fixed(last_rate_hz_, 1) + " messages/s processed, arrival-to-processing latency median " +
-                    Fixed(last_latency_median_ms_, 2) + " ms, max " + Fixed(last_latency_max_ms_, 2) + " ms; " +
-                    std::to_string(node_.rejected_total()) + " rejected, " + std::to_string(dropped_scans_) +
-                    " stale scans dropped, " + std::to_string(watchdog_.halts()) + " sensor stops");
-  }
-  latency_ms_.clear();
-  delivered_at_report_ = delivered_;
-  last_report_ = now;
-}
-
-double LcmLiveSource::Progress() const {
-  if (o_.duration_s <= 0) return 0.0;
-  return std::min(1.0, std::chrono::duration<double>(Clock::now() - start_).count() / o_.duration_s);
-}
-
-std::vector<std::pair<std::string, std::string>> LcmLiveSource::Details() const {
-  std::vector<std::pair<std::string, std::string>> d = {
-      {"url", node_.url()},
-      {"messages processed", std::to_string(delivered_)},
-      {"rejected (malformed or unknown)", std::to_string(node_.rejected_total())},
-      {"stale scans dropped", std::to_string(dropped_scans_)},
-      {"sensor stops", std::to_string(watchdog_.halts())},
-      {"commands held back", std::to_string(watchdog_.held())},
-      {"loop rate", Fixed(last_rate_hz_, 1) + " messages/s"},
-      {"latency",
-       "median " + Fixed(last_latency_median_ms_, 2) + " ms, max " + Fixed(last_latency_max_ms_, 2) + " ms"}};
-  for (const auto& [channel, s] : node_.stats()) {
-    if (s.rejected + s.unknown > 0)
-      d.push_back({"rejected on " + channel, std::to_string(s.rejected + s.unknown) + " (" + s.last_error + ")"});
-    if (s.own_echoes > 0) d.push_back({"own messages looped back on " + channel, std::to_string(s.own_echoes)});
-  }
-  return d;
+std::unique_ptr<Source> OpenLcmLive(const SourceOptions& options) {
+  const LiveSourceOptions o = ExtraOr<LiveSourceOptions>(options);
+  return std::make_unique<LiveSource>(std::make_unique<LcmLink>(options.path, o.channels, options.roles), o,
+                                      "live LCM");
 }
 
 }  // namespace mbot::lcmio

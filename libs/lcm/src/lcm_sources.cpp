@@ -20,23 +20,6 @@ using namespace msgs;  // the event vocabulary
 std::unique_ptr<Source> OpenLcmRelay(const SourceOptions& options);
 StageType LcmBridgeStageType();
 
-LiveSourceOptions ParseLiveSourceOptions(config::Section& s) {
-  const auto doc = [](const char* text) { return std::string("lcm_live: ") + text; };
-  LiveSourceOptions o;
-  o.channels = s.GetList("channels", o.channels, doc("channels to subscribe to"));
-  o.duration_s = s.GetDouble("duration_s", o.duration_s, doc("the run ends after this long (0: never) [s]"), 0.0, 1e7);
-  o.end_after_silence_s =
-      s.GetDouble("end_after_silence_s", o.end_after_silence_s,
-                  doc("the run ends when no message arrived for this long (0: never) [s]"), 0.0, 1e7);
-  o.stale_sensor_s = s.GetDouble("stale_sensor_s", o.stale_sensor_s,
-                                 doc("a watched channel silent this long stops the robot [s]"), 0.01, 1e4);
-  o.watched = s.GetList("watched_channels", o.watched, doc("channels whose silence stops the robot"));
-  o.command_channel = s.GetString("command_channel", o.command_channel, doc("velocity commands go out here"));
-  o.report_every_s = s.GetDouble("report_every_s", o.report_every_s,
-                                 doc("log the loop rate and latency this often (0: never) [s]"), 0.0, 1e6);
-  return o;
-}
-
 namespace {
 
 bool IsLcmLog(const std::string& path) {
@@ -127,9 +110,9 @@ void RegisterLcmTransport() {
                   0,
                   [](config::Section& s, SourceOptions* o) {
                     ParseChannelRoles(s, &o->roles);
-                    o->extra = ParseLiveSourceOptions(s);
+                    o->extra = ParseLiveSourceOptions(s, "lcm_live");
                   },
-                  [](const SourceOptions& o) { return std::make_unique<LcmLiveSource>(o); }};
+                  OpenLcmLive};
   live.default_url = kDefaultLcmUrl;
   RegisterSourceType(std::move(live));
   SourceType relay{"lcm_relay",

@@ -12,6 +12,7 @@
 #include "mbot/msgs/visitor.hpp"
 #include "mbot/ros2/mcap_writer.hpp"
 #include "mbot/ros2/messages.hpp"
+#include "event_encoder.hpp"
 #include "mbot/ros2/ros2_transport.hpp"
 
 namespace mbot::config {
@@ -20,13 +21,7 @@ class Section;
 
 namespace mbot::ros2 {
 
-struct BagQos {
-  int depth = 10;
-  bool reliable = true;
-  bool transient_local = false;
-};
-// The QoS the MBot offers on a topic (what the bag's metadata says each was recorded with).
-BagQos DefaultQos(const std::string& topic);
+using BagQos = Qos;  // what the bag's metadata says each topic was recorded with (DefaultQos)
 
 struct BagRecorderOptions {
   std::string file = "run.mcap";
@@ -37,7 +32,7 @@ struct BagRecorderOptions {
 };
 BagRecorderOptions ParseBagRecorderOptions(config::Section& section);
 
-class BagRecorder : public msgs::Output, private msgs::EventVisitor {
+class BagRecorder : public msgs::Output {
  public:
   explicit BagRecorder(BagRecorderOptions options);
   ~BagRecorder() override;
@@ -46,15 +41,6 @@ class BagRecorder : public msgs::Output, private msgs::EventVisitor {
   void Close(bool interrupted) override;
 
  private:
-  bool Lidar(const msgs::Event&, const msgs::LidarScan&) override;
-  bool Pose(const msgs::Event&, const msgs::Pose2D&) override;
-  bool ImuReading(const msgs::Event&, const msgs::Imu&) override;
-  bool Motors(const msgs::Event&, const msgs::MotorCommand&) override;
-  bool Map(const msgs::Event&, const msgs::OccupancyGrid&) override;
-  bool PathPoses(const msgs::Event&, const msgs::Path&) override;
-  bool ParticleSet(const msgs::Event&, const msgs::Particles&) override;
-
-  std::string TopicFor(const msgs::Event& event) const;
   uint16_t Channel(const std::string& topic, const std::string& type);  // 0: the topic has another type
   void Put(const std::string& topic, const std::string& type, int64_t t_us, const std::vector<uint8_t>& cdr);
   std::string MetadataYaml(bool for_file) const;
@@ -70,9 +56,8 @@ class BagRecorder : public msgs::Output, private msgs::EventVisitor {
   };
   std::map<std::string, ChannelInfo> channels_;
   std::map<std::string, long long> skipped_;
-  msgs::Pose2D mount_, odom_;
-  bool mount_written_ = false, have_odom_ = false;
-  long long binned_ = 0;
+  EventEncoder encoder_;
+  std::vector<EncodedMessage> encoded_;
 };
 
 }  // namespace mbot::ros2

@@ -18,6 +18,7 @@
 #include "mbot/ros2/messages.hpp"
 #include "mbot/ros2/ros2_transport.hpp"
 #include "mbot/ros2/transforms.hpp"
+#include "message_decoder.hpp"
 
 namespace mbot::ros2 {
 
@@ -54,7 +55,7 @@ class McapBagSource : public msgs::Source {
  private:
   // What a channel's messages become, worked out once per channel.
   struct Route {
-    enum Type { kUnknown, kScan, kOdometry, kImu, kTwist, kTf, kPoseStamped, kPoseWithCovariance } type = kUnknown;
+    MessageDecoder::Type type = MessageDecoder::Type::kUnknown;
     std::string wire, topic, type_name;
     Serialization serialization = Serialization::kCdr;
     msgs::ChannelInfo* info = nullptr;  // nullptr: a channel the file never declared
@@ -63,8 +64,6 @@ class McapBagSource : public msgs::Source {
   bool ReadMore();  // one more message into pending_; false at the end of the last file
   void Handle(const McapMessage& m);
   void Reject(const std::string& topic, const McapMessage& m, const std::string& why);
-  bool LidarEvent(const LaserScan& scan, const std::string& topic, msgs::Event* ev);
-  std::optional<msgs::Pose2D> Mount(const std::string& frame, bool* mirrored);
 
   msgs::SourceOptions options_;
   BagSourceOptions bag_;
@@ -77,13 +76,7 @@ class McapBagSource : public msgs::Source {
   std::multimap<int64_t, msgs::Event> pending_;  // by t_us, within the reorder window
   int64_t last_emitted_us_ = INT64_MIN;
   bool eof_ = false;
-  StaticTransforms tf_static_;
-  std::string odom_child_frame_;
-  struct MountCache {
-    msgs::Pose2D pose;
-    bool mirrored = false;
-  };
-  std::map<std::string, MountCache> mounts_;  // scan frame → its mount, once the tree connects it
+  MessageDecoder decoder_;
   std::set<std::string> warned_;
   long long messages_ = 0, chunks_ = 0, crcs_ = 0;
 };

@@ -67,6 +67,25 @@ const std::map<std::string, Def>& Defs() {
       {"nav_msgs/OccupancyGrid",
        {"std_msgs/Header header\nnav_msgs/MapMetaData info\nint8[] data\n",
         {"std_msgs/Header", "nav_msgs/MapMetaData"}}},
+      {"std_msgs/String", {"string data\n", {}}},
+      {"std_msgs/ColorRGBA", {"float32 r\nfloat32 g\nfloat32 b\nfloat32 a\n", {}}},
+      {"builtin_interfaces/Duration", {"int32 sec\nuint32 nanosec\n", {}}},
+      {"mbot_interfaces/Encoders",
+       {"builtin_interfaces/Time stamp\nint64[3] ticks\nint32[3] delta_ticks\nint32 delta_time\n",
+        {"builtin_interfaces/Time"}}},
+      {"sensor_msgs/CompressedImage", {"std_msgs/Header header\nstring format\nuint8[] data\n", {"std_msgs/Header"}}},
+      {"visualization_msgs/UVCoordinate", {"float32 u\nfloat32 v\n", {}}},
+      {"visualization_msgs/MeshFile", {"string filename\nuint8[] data\n", {}}},
+      {"visualization_msgs/Marker",
+       {"std_msgs/Header header\nstring ns\nint32 id\nint32 type\nint32 action\ngeometry_msgs/Pose pose\n"
+        "geometry_msgs/Vector3 scale\nstd_msgs/ColorRGBA color\nbuiltin_interfaces/Duration lifetime\n"
+        "bool frame_locked\ngeometry_msgs/Point[] points\nstd_msgs/ColorRGBA[] colors\nstring texture_resource\n"
+        "sensor_msgs/CompressedImage texture\nvisualization_msgs/UVCoordinate[] uv_coordinates\nstring text\n"
+        "string mesh_resource\nvisualization_msgs/MeshFile mesh_file\nbool mesh_use_embedded_materials\n",
+        {"std_msgs/Header", "geometry_msgs/Pose", "geometry_msgs/Vector3", "std_msgs/ColorRGBA",
+         "builtin_interfaces/Duration", "geometry_msgs/Point", "sensor_msgs/CompressedImage",
+         "visualization_msgs/UVCoordinate", "visualization_msgs/MeshFile"}}},
+      {"visualization_msgs/MarkerArray", {"visualization_msgs/Marker[] markers\n", {"visualization_msgs/Marker"}}},
       {"nav_msgs/Path",
        {"std_msgs/Header header\ngeometry_msgs/PoseStamped[] poses\n",
         {"std_msgs/Header", "geometry_msgs/PoseStamped"}}},

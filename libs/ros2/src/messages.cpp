@@ -127,6 +127,42 @@ PoseWithCovarianceStamped DecodePoseWithCovarianceStamped(const uint8_t* data, s
   return m;
 }
 
+OccupancyGrid DecodeOccupancyGrid(const uint8_t* data, size_t size, Serialization serialization) {
+  CdrReader r = Reader(data, size, serialization);
+  OccupancyGrid m;
+  m.header = ReadHeader(r);
+  m.info.map_load_time.sec = r.I32("info.map_load_time.sec");
+  m.info.map_load_time.nanosec = r.U32("info.map_load_time.nanosec");
+  m.info.resolution = r.F32("info.resolution");
+  m.info.width = r.U32("info.width");
+  m.info.height = r.U32("info.height");
+  m.info.origin.position = ReadVector3(r, "info.origin.position");
+  m.info.origin.orientation = ReadQuaternion(r, "info.origin.orientation");
+  m.data = r.I8s("data");
+  if (uint64_t(m.info.width) * m.info.height != m.data.size()) {
+    throw CdrError("data: " + std::to_string(m.data.size()) + " cells for a " + std::to_string(m.info.width) + " x " +
+                       std::to_string(m.info.height) + " map",
+                   r.offset());
+  }
+  return m;
+}
+
+String DecodeString(const uint8_t* data, size_t size, Serialization serialization) {
+  CdrReader r = Reader(data, size, serialization);
+  return String{r.String("data")};
+}
+
+Encoders DecodeEncoders(const uint8_t* data, size_t size, Serialization serialization) {
+  CdrReader r = Reader(data, size, serialization);
+  Encoders m;
+  m.stamp.sec = r.I32("stamp.sec");
+  m.stamp.nanosec = r.U32("stamp.nanosec");
+  for (int64_t& t : m.ticks) t = r.I64("ticks");
+  for (int32_t& d : m.delta_ticks) d = r.I32("delta_ticks");
+  m.delta_time = r.I32("delta_time");
+  return m;
+}
+
 std::vector<uint8_t> Encode(const LaserScan& m) {
   CdrWriter w;
   WriteHeader(w, m.header);
@@ -229,6 +265,52 @@ std::vector<uint8_t> Encode(const OccupancyGrid& m) {
   WriteVector3(w, m.info.origin.position);
   WriteQuaternion(w, m.info.origin.orientation);
   w.I8s(m.data);
+  return w.bytes();
+}
+
+std::vector<uint8_t> Encode(const String& m) {
+  CdrWriter w;
+  w.String(m.data);
+  return w.bytes();
+}
+
+std::vector<uint8_t> Encode(const Encoders& m) {
+  CdrWriter w;
+  w.I32(m.stamp.sec);
+  w.U32(m.stamp.nanosec);
+  for (int64_t t : m.ticks) w.I64(t);
+  for (int32_t d : m.delta_ticks) w.I32(d);
+  w.I32(m.delta_time);
+  return w.bytes();
+}
+
+std::vector<uint8_t> Encode(const MarkerArray& m) {
+  CdrWriter w;
+  w.U32(static_cast<uint32_t>(m.markers.size()));
+  for (const Marker& k : m.markers) {
+    WriteHeader(w, k.header);
+    w.String(k.ns);
+    w.I32(k.id), w.I32(k.type), w.I32(k.action);
+    WriteVector3(w, k.pose.position);
+    WriteQuaternion(w, k.pose.orientation);
+    WriteVector3(w, k.scale);
+    w.F32(k.color.r), w.F32(k.color.g), w.F32(k.color.b), w.F32(k.color.a);
+    w.I32(k.lifetime.sec), w.U32(k.lifetime.nanosec);
+    w.Bool(k.frame_locked);
+    w.U32(static_cast<uint32_t>(k.points.size()));
+    for (const Vector3& p : k.points) WriteVector3(w, p);
+    w.U32(static_cast<uint32_t>(k.colors.size()));
+    for (const ColorRGBA& c : k.colors) w.F32(c.r), w.F32(c.g), w.F32(c.b), w.F32(c.a);
+    w.String("");              // texture_resource
+    WriteHeader(w, Header{});  // texture (sensor_msgs/CompressedImage): header,
+    w.String("");              // format,
+    w.U32(0);                  // data
+    w.U32(0);                  // uv_coordinates
+    w.String(k.text);
+    w.String("");            // mesh_resource
+    w.String(""), w.U32(0);  // mesh_file: filename, data
+    w.Bool(k.mesh_use_embedded_materials);
+  }
   return w.bytes();
 }
 

@@ -6,6 +6,7 @@
 
 #include "bag_recorder.hpp"
 #include "bag_source.hpp"
+#include "ros2_live.hpp"
 #include "mbot/common/config.hpp"
 #include "mbot/msgs/source.hpp"
 
@@ -25,6 +26,7 @@ msgs::TopicTable DefaultTopics() {
                            {topics::kSlamParticles, "/particle_cloud"},
                            {topics::kPath, "/planned_path"},
                            {topics::kFrontiers, "/frontier_markers"},
+                           {topics::kMissionStatus, "/mission_state"},
                            {topics::kTruePose, "/ground_truth"}});
 }
 
@@ -85,6 +87,26 @@ void RegisterRos2Transport() {
                             "the same topics and keys as mcap",
                             IsRos1Bag, 10, ParseBagOptions,
                             [](const msgs::SourceOptions& o) { return std::make_unique<McapBagSource>(o); }});
+  msgs::SourceType live{
+      "ros2_live",
+      "a ROS 2 robot (or the simulated one, sim_robot_ros2.ini) over DDS, in wall-clock time; url "
+      "is dds:<ROS_DOMAIN_ID>; topics, frames and QoS are the MBot's unless `topics` says otherwise",
+      nullptr,
+      0,
+      [](config::Section& s, msgs::SourceOptions* o) {
+        ParseChannelRoles(s, &o->roles);
+        Ros2LiveOptions r;
+        r.node = ParseRos2NodeOptions(s, "dds:0");
+        msgs::LiveSourceOptions d;
+        d.channels = {msgs::topics::kLidar, msgs::topics::kOdometry, msgs::topics::kImu, msgs::topics::kEncoders};
+        r.live = msgs::ParseLiveSourceOptions(s, "ros2_live", d);
+        o->extra = r;
+      },
+      OpenRos2Live};
+  live.path_kind = msgs::SourceType::Path::kUnchecked;
+  live.default_url = "dds:0";
+  msgs::RegisterSourceType(std::move(live));
+  msgs::RegisterStageType(Ros2BridgeStageType());
   msgs::OutputType recorder;
   recorder.name = "rosbag2";
   recorder.doc =

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mbot/msgs/events.hpp"
+#include "mbot/msgs/live_source.hpp"
 #include "mbot/msgs/source.hpp"
 
 namespace mbot::lcmio {
@@ -70,7 +71,7 @@ class LcmNode {
 };
 
 // Wall-clock time in µs since the epoch.
-int64_t WallClockUs();
+using msgs::WallClockUs;
 
 // LCM takes a channel name as a regular expression: this one matches `channel` alone.
 std::string LcmChannelPattern(const std::string& channel);

@@ -100,6 +100,37 @@ struct OccupancyGrid {  // nav_msgs/OccupancyGrid: row-major from the origin; 0-
   std::vector<int8_t> data;
 };
 
+struct String {  // std_msgs/String
+  std::string data;
+};
+struct Encoders {  // mbot_interfaces/Encoders (the MBot's firmware): [0] left, [1] right, [2] unused
+  Time stamp;
+  std::array<int64_t, 3> ticks{};
+  std::array<int32_t, 3> delta_ticks{};
+  int32_t delta_time = 0;  // [µs]
+};
+struct ColorRGBA {  // std_msgs/ColorRGBA
+  float r = 0, g = 0, b = 0, a = 0;
+};
+struct Marker {  // visualization_msgs/Marker (Jazzy: with texture, uv_coordinates and mesh_file)
+  Header header;
+  std::string ns;
+  int32_t id = 0, type = 0, action = 0;
+  Pose pose;
+  Vector3 scale;
+  ColorRGBA color;
+  Time lifetime;  // builtin_interfaces/Duration: the same two fields
+  bool frame_locked = false;
+  std::vector<Vector3> points;
+  std::vector<ColorRGBA> colors;
+  std::string text;  // texture_resource, texture, uv_coordinates, mesh_resource, mesh_file: empty
+  bool mesh_use_embedded_materials = false;
+  static constexpr int32_t kPoints = 8, kAdd = 0, kDeleteAll = 3;
+};
+struct MarkerArray {  // visualization_msgs/MarkerArray
+  std::vector<Marker> markers;
+};
+
 // The ROS 2 type names ("sensor_msgs/msg/LaserScan"), as rosbag2 and the DDS layer name them.
 inline constexpr const char* kLaserScanType = "sensor_msgs/msg/LaserScan";
 inline constexpr const char* kOdometryType = "nav_msgs/msg/Odometry";
@@ -111,6 +142,9 @@ inline constexpr const char* kPoseWithCovarianceStampedType = "geometry_msgs/msg
 inline constexpr const char* kPoseArrayType = "geometry_msgs/msg/PoseArray";
 inline constexpr const char* kPathType = "nav_msgs/msg/Path";
 inline constexpr const char* kOccupancyGridType = "nav_msgs/msg/OccupancyGrid";
+inline constexpr const char* kStringType = "std_msgs/msg/String";
+inline constexpr const char* kEncodersType = "mbot_interfaces/msg/Encoders";
+inline constexpr const char* kMarkerArrayType = "visualization_msgs/msg/MarkerArray";
 
 // How a payload is serialized: ROS 2's CDR, or ROS 1's (a ROS 1 bag: packed, Header with seq).
 enum class Serialization { kCdr, kRos1 };
@@ -123,6 +157,9 @@ TFMessage DecodeTFMessage(const uint8_t* data, size_t size, Serialization s = Se
 PoseStamped DecodePoseStamped(const uint8_t* data, size_t size, Serialization s = Serialization::kCdr);
 PoseWithCovarianceStamped DecodePoseWithCovarianceStamped(const uint8_t* data, size_t size,
                                                           Serialization s = Serialization::kCdr);
+OccupancyGrid DecodeOccupancyGrid(const uint8_t* data, size_t size, Serialization s = Serialization::kCdr);
+String DecodeString(const uint8_t* data, size_t size, Serialization s = Serialization::kCdr);
+Encoders DecodeEncoders(const uint8_t* data, size_t size, Serialization s = Serialization::kCdr);
 
 std::vector<uint8_t> Encode(const LaserScan& m);
 std::vector<uint8_t> Encode(const Odometry& m);
@@ -134,6 +171,9 @@ std::vector<uint8_t> Encode(const PoseWithCovarianceStamped& m);
 std::vector<uint8_t> Encode(const PoseArray& m);
 std::vector<uint8_t> Encode(const Path& m);
 std::vector<uint8_t> Encode(const OccupancyGrid& m);
+std::vector<uint8_t> Encode(const String& m);
+std::vector<uint8_t> Encode(const Encoders& m);
+std::vector<uint8_t> Encode(const MarkerArray& m);
 
 // A planar yaw from a quaternion, and back (the MBot's frames differ by yaw only).
 double Yaw(const Quaternion& q);

@@ -17,6 +17,16 @@ namespace mbot::ros2 {
 // The MBot's ROS 2 names for the pipeline's topics (what mbot_ros2_ws and its lab nodes publish).
 msgs::TopicTable DefaultTopics();
 
+// The QoS of a ROS 2 topic (rosbag2's offered_qos_profiles, the DDS readers' and writers').
+struct Qos {
+  int depth = 10;
+  bool reliable = true;
+  bool transient_local = false;
+};
+// What the MBot offers on a topic: sensors from the firmware best effort, the lidar and the
+// autonomy's topics reliable, /map and /tf_static reliable + transient local (a late RViz gets them).
+Qos DefaultQos(const std::string& topic);
+
 // [source] type = mcap.
 struct BagSourceOptions {
   msgs::TopicTable topics = DefaultTopics();

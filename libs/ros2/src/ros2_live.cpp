@@ -1,0 +1,285 @@
+#include "ros2_live.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <stdexcept>
+
+#include "mbot/common/config.hpp"
+#include "mbot/common/log.hpp"
+#include "mbot/msgs/topics.hpp"
+
+namespace mbot::ros2 {
+
+using msgs::Event;
+using msgs::EventKind;
+namespace topics = msgs::topics;
+
+std::string DefaultRosType(const std::string& topic) {
+  static const std::map<std::string, std::string> types = {{topics::kLidar, kLaserScanType},
+                                                           {topics::kOdometry, kOdometryType},
+                                                           {topics::kImu, kImuType},
+                                                           {topics::kEncoders, kEncodersType},
+                                                           {topics::kVelocityCommand, kTwistType},
+                                                           {topics::kSlamMap, kOccupancyGridType},
+                                                           {topics::kSlamPose, kPoseStampedType},
+                                                           {topics::kTruePose, kPoseStampedType},
+                                                           {topics::kMissionStatus, kStringType},
+                                                           {topics::kSlamParticles, kPoseArrayType},
+                                                           {topics::kPath, kPathType},
+                                                           {topics::kFrontiers, kMarkerArrayType}};
+  auto it = types.find(topic);
+  return it == types.end() ? "" : it->second;
+}
+
+namespace {
+
+int ParseDomain(const std::string& url) {
+  // dds:<domain id>, the ROS_DOMAIN_ID of the robot's network.
+  if (url.rfind("dds:", 0) == 0) {
+    const std::string n = url.substr(4);
+    char* end = nullptr;
+    const long d = std::strtol(n.c_str(), &end, 10);
+    if (!n.empty() && end && *end == '\0' && d >= 0 && d <= 232) return static_cast<int>(d);
+  }
+  throw std::runtime_error("url '" + url + "': expected dds:<domain id 0..232> (the robot's ROS_DOMAIN_ID)");
+}
+
+// What a topic is read with: best effort matches both kinds of writer; latched topics reliable +
+// transient local, so what was published before we joined arrives.
+Qos ReaderQos(const std::string& wire) {
+  Qos q = DefaultQos(wire);
+  if (!q.transient_local) q.reliable = false;
+  return q;
+}
+
+}  // namespace
+
+Ros2NodeOptions ParseRos2NodeOptions(config::Section& s, const std::string& url) {
+  Ros2NodeOptions o;
+  o.dds.domain_id = ParseDomain(url);
+  o.dds.max_sample_bytes = static_cast<size_t>(
+      s.GetDouble("max_message_mb", o.dds.max_sample_bytes / 1048576.0,
+                  "ros2: a message larger than this is dropped on receipt (and counted) [MiB]", 0.001, 4096) *
+      1048576.0);
+  o.dds.config = s.GetString("dds_config", o.dds.config,
+                             "ros2: Cyclone DDS configuration (XML or file://…; '' = CYCLONEDDS_URI or its defaults)");
+  o.topics.Parse(s, "topics");
+  o.robot_frame = s.GetString("robot_frame", o.robot_frame,
+                              "ros2: the robot's frame, whose transform to the scan's frame (/tf_static) is the "
+                              "lidar's mount ('' = the frame /odom moves, else base_footprint)");
+  o.frames.map = s.GetString("map_frame", o.frames.map, "ros2: the map's frame");
+  o.frames.odom = s.GetString("odom_frame", o.frames.odom, "ros2: the odometry's frame");
+  o.frames.robot = s.GetString("base_frame", o.frames.robot, "ros2: the robot's frame (odometry's child)");
+  o.frames.lidar = s.GetString("lidar_frame", o.frames.lidar, "ros2: the scans' frame (what a simulated robot says)");
+  o.frames.imu = s.GetString("imu_frame", o.frames.imu, "ros2: the IMU's frame");
+  return o;
+}
+
+Ros2Node::Ros2Node(Ros2NodeOptions options, const std::vector<std::string>& channels, const msgs::ChannelRoles& roles)
+    : o_(std::move(options)),
+      roles_(roles),
+      dds_(o_.dds),
+      decoder_(o_.robot_frame, "ros2"),
+      encoder_(o_.topics, o_.frames) {
+  auto subscribe = [this](const std::string& topic, const std::string& wire, const std::string& type) {
+    const int reader = dds_.AddReader(wire, type, ReaderQos(wire));
+    routes_.resize(reader + 1);
+    routes_[reader] = {topic, wire, type, MessageDecoder::TypeOf(type, wire)};
+    stats_[wire].type = type;
+  };
+  for (const std::string& c : channels) {
+    auto t = o_.types.find(c);
+    const std::string type = t != o_.types.end() ? t->second : DefaultRosType(c);
+    if (type.empty()) throw std::runtime_error("ros2: channel " + c + " has no ROS 2 message this transport knows");
+    subscribe(c, o_.topics.Wire(c), type);
+  }
+  subscribe("/tf_static", "/tf_static", kTFMessageType);
+}
+
+void Ros2Node::Poll(int timeout_ms, std::vector<Event>* out) {
+  dds_.Take(timeout_ms, [&](const DdsParticipant::Sample& s) {
+    const Route& r = routes_[s.reader];
+    TopicStats& st = stats_[r.wire];
+    ++st.received;
+    Event ev;
+    ev.t_us = msgs::WallClockUs();
+    ev.channel = r.topic;
+    std::string refused, error;
+    bool got = false;
+    try {
+      got =
+          decoder_.Decode(r.kind, r.topic, r.wire, s.data, s.size, Serialization::kCdr, ev.t_us, roles_, &ev, &refused);
+      if (got && !msgs::IsPlausibleTimeUs(ev.stamp_us)) error = "absurd stamp " + std::to_string(ev.stamp_us) + " µs";
+    } catch (const std::exception& e) {  // CdrError names the field and offset
+      error = r.type + ": " + e.what();
+    }
+    if (!refused.empty()) error = "transforms refused: " + refused;
+    if (!error.empty()) {
+      ++st.rejected;
+      st.last_error = error;
+      mbot::log::WarnOnce("ros2:rejected:" + r.wire,
+                          "ros2: " + r.wire + ": malformed message rejected (" + error + "); further ones are counted");
+      if (!got || !refused.empty()) return;
+      if (!msgs::IsPlausibleTimeUs(ev.stamp_us)) return;
+    }
+    if (got && ev.kind != EventKind::kOther) out->push_back(std::move(ev));
+  });
+}
+
+void Ros2Node::PrepareWriter(const std::string& wire, const std::string& type) {
+  if (writers_.count(wire)) return;
+  writers_[wire] = dds_.AddWriter(wire, type, DefaultQos(wire));
+  writer_types_[wire] = type;
+  stats_[wire].type = type;
+}
+
+bool Ros2Node::Publish(const Event& event) {
+  encoded_.clear();
+  if (!encoder_.Encode(event, &encoded_)) return false;
+  bool sent = false;
+  for (const EncodedMessage& m : encoded_) {
+    PrepareWriter(m.topic, m.type);
+    if (writer_types_[m.topic] != m.type) {  // one type per topic, as ROS has it
+      mbot::log::WarnOnce("ros2:type:" + m.topic, "ros2: " + m.topic + " carries " + writer_types_[m.topic] + "; a " +
+                                                      m.type + " for it is not sent");
+      continue;
+    }
+    if (dds_.Write(writers_[m.topic], m.cdr.data(), m.cdr.size())) {
+      ++stats_[m.topic].published;
+      sent = true;
+    } else {
+      mbot::log::WarnOnce("ros2:write:" + m.topic, "ros2: writing " + m.topic + " failed");
+    }
+  }
+  return sent;
+}
+
+long long Ros2Node::rejected_total() const {
+  long long n = dds_.too_large();
+  for (const auto& [wire, s] : stats_) n += s.rejected;
+  return n;
+}
+
+std::vector<std::pair<std::string, std::string>> Ros2Node::Details() const {
+  std::vector<std::pair<std::string, std::string>> d;
+  for (const auto& [wire, s] : stats_) {
+    if (s.rejected > 0) d.push_back({"rejected on " + wire, std::to_string(s.rejected) + " (" + s.last_error + ")"});
+  }
+  if (dds_.too_large() > 0) d.push_back({"messages too large (dropped)", std::to_string(dds_.too_large())});
+  for (auto& kv : decoder_.Details()) d.push_back(std::move(kv));
+  return d;
+}
+
+namespace {
+
+class Ros2Link : public msgs::LiveLink {
+ public:
+  Ros2Link(Ros2NodeOptions o, const std::vector<std::string>& channels, const msgs::ChannelRoles& roles,
+           const std::string& command_channel)
+      : topics_(o.topics), node_(std::move(o), channels, roles) {
+    node_.PrepareWriter(topics_.Wire(command_channel), kTwistType);  // discovery before the first command
+  }
+  void Poll(int timeout_ms, std::vector<Event>* out) override { node_.Poll(timeout_ms, out); }
+  bool Publish(const Event& event) override { return node_.Publish(event); }
+  long long rejected_total() const override { return node_.rejected_total(); }
+  std::string name() const override { return "ros2"; }
+  std::string where() const override { return node_.where(); }
+  msgs::ChannelInfo Describe(const std::string& channel) const override {
+    const std::string wire = topics_.Wire(channel);
+    auto it = node_.stats().find(wire);
+    return msgs::ChannelInfo{it != node_.stats().end() ? it->second.type : "", "ROS 2 " + wire + " (cdr, DDS)",
+                             EventKind::kOther, true};
+  }
+  std::vector<std::pair<std::string, std::string>> Details() const override { return node_.Details(); }
+
+ private:
+  msgs::TopicTable topics_;
+  Ros2Node node_;
+};
+
+}  // namespace
+
+std::unique_ptr<msgs::Source> OpenRos2Live(const msgs::SourceOptions& options) {
+  Ros2LiveOptions o = msgs::ExtraOr<Ros2LiveOptions>(options);
+  o.node.dds.domain_id = ParseDomain(options.path.empty() ? "dds:0" : options.path);
+  return std::make_unique<msgs::LiveSource>(
+      std::make_unique<Ros2Link>(o.node, o.live.channels, options.roles, o.live.command_channel), o.live,
+      "live ROS 2 (DDS)");
+}
+
+namespace {
+
+// `ros2_bridge`: this pipeline on ROS 2 from the robot's side. Every event it sees on a `publish`
+// channel goes out as the MBot's message on the robot's topic and QoS (/scan, /odom with odom →
+// base_footprint on /tf, the lidar's mount on /tf_static, /imu, /encoders); messages arriving on
+// `subscribe` channels (/cmd_vel from the autonomy, and what it publishes for a referee) come in
+// validated and are emitted to the later stages and the sink (the simulator), stamped with the
+// time of the event being processed. So `config/sim_robot_ros2.ini` is a robot an autonomy process
+// cannot tell from a real one.
+struct BridgeOptions {
+  Ros2NodeOptions node;
+  std::vector<std::string> publish = {topics::kLidar, topics::kOdometry, topics::kEncoders, topics::kImu};
+  std::vector<std::string> subscribe = {topics::kVelocityCommand};
+};
+
+class Ros2BridgeStage : public msgs::Stage {
+ public:
+  explicit Ros2BridgeStage(BridgeOptions o) : o_(std::move(o)), publish_(o_.publish.begin(), o_.publish.end()) {}
+
+  void Start(const msgs::RunContext& ctx) override {
+    bus_ = ctx.bus;
+    msgs::ChannelRoles roles;
+    roles.reference_pose.clear();  // the pose coming back is the stack's estimate, not a reference
+    roles.pose_estimate = {topics::kSlamPose};
+    node_ = std::make_unique<Ros2Node>(o_.node, o_.subscribe, roles);
+    mbot::log::Info("ros2_bridge: publishing " + std::to_string(publish_.size()) + " channels on " + node_->where());
+  }
+
+  void OnEvent(const Event& ev) override {
+    if (publish_.count(ev.channel)) node_->Publish(ev);
+    got_.clear();
+    node_->Poll(0, &got_);
+    for (Event& in : got_) {
+      in.t_us = ev.t_us;  // into this pipeline's (the simulation's) time
+      if (bus_) bus_->Emit(this, in);
+    }
+  }
+
+  void Finish(const msgs::RunContext& /*ctx*/, bool /*interrupted*/) override {
+    if (!node_) return;
+    std::string counts;
+    for (const auto& [wire, s] : node_->stats()) {
+      counts += (counts.empty() ? "" : ", ") + wire + " " + std::to_string(s.received) + " in / " +
+                std::to_string(s.published) + " out" +
+                (s.rejected ? " / " + std::to_string(s.rejected) + " rejected" : "");
+    }
+    mbot::log::Info("ros2_bridge: " + counts);
+  }
+
+ private:
+  BridgeOptions o_;
+  std::set<std::string> publish_;
+  msgs::Bus* bus_ = nullptr;
+  std::unique_ptr<Ros2Node> node_;
+  std::vector<Event> got_;
+};
+
+}  // namespace
+
+msgs::StageType Ros2BridgeStageType() {
+  return {
+      "ros2_bridge",
+      "the robot's side of ROS 2 (DDS): publishes the events it sees on `publish` channels as the MBot's "
+      "messages, topics and QoS, and emits the validated messages arriving on `subscribe` channels",
+      [](config::Section& s) -> std::unique_ptr<msgs::Stage> {
+        BridgeOptions o;
+        const std::string url =
+            s.GetString("url", "dds:0", "ros2_bridge: dds:<domain id> (the ROS_DOMAIN_ID of the network)");
+        o.node = ParseRos2NodeOptions(s, url);
+        o.publish = s.GetList("publish", o.publish, "channels published (what the robot's firmware and lidar publish)");
+        o.subscribe = s.GetList("subscribe", o.subscribe, "channels listened to (the autonomy's commands and outputs)");
+        return std::make_unique<Ros2BridgeStage>(o);
+      }};
+}
+
+}  // namespace mbot::ros2

@@ -1,0 +1,92 @@
+// ROS 2 live, over DDS (dds.hpp): Ros2Node subscribes to ROS topics and turns their messages into
+// validated events (message_decoder.hpp: the lidar's mount from /tf_static, a malformed message
+// counted and named, never passed on), and publishes events as ROS 2 messages (event_encoder.hpp)
+// on writers with each topic's QoS. The live source (`[source] type = ros2_live`) is a
+// msgs::LiveSource on it; the simulated robot's side is the `ros2_bridge` stage.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "event_encoder.hpp"
+#include "message_decoder.hpp"
+#include "mbot/msgs/live_source.hpp"
+#include "mbot/msgs/stage.hpp"
+#include "mbot/ros2/dds.hpp"
+
+namespace mbot::config {
+class Section;
+}
+
+namespace mbot::ros2 {
+
+struct Ros2NodeOptions {
+  DdsOptions dds;
+  msgs::TopicTable topics = DefaultTopics();
+  Frames frames;
+  std::string robot_frame;  // whose transform to the scan's frame is the lidar's mount ("" = /odom's child)
+  // ROS types of the topics read (pipeline topic → type); the MBot's by default (DefaultRosType).
+  std::map<std::string, std::string> types;
+};
+// The ROS 2 type a pipeline topic carries on the MBot ("" when none is known).
+std::string DefaultRosType(const std::string& topic);
+
+// [source] / [stage] keys shared by ros2_live and ros2_bridge: url (dds:<domain>), topics, frames.
+Ros2NodeOptions ParseRos2NodeOptions(config::Section& section, const std::string& url);
+
+class Ros2Node {
+ public:
+  // Subscribes to `channels` (pipeline topics; /tf_static always, for the mount). Throws
+  // std::runtime_error naming a channel with no known ROS type or a topic DDS refuses.
+  Ros2Node(Ros2NodeOptions options, const std::vector<std::string>& channels, const msgs::ChannelRoles& roles);
+
+  // Waits up to timeout_ms, then takes what arrived: events in arrival order, t_us = when taken.
+  void Poll(int timeout_ms, std::vector<msgs::Event>* out);
+  // Publishes the messages the event becomes (a writer per topic, made on first use with the
+  // topic's QoS); false when it has none.
+  bool Publish(const msgs::Event& event);
+  // A writer for `topic` now (so discovery is under way before the first message).
+  void PrepareWriter(const std::string& wire, const std::string& type);
+
+  struct TopicStats {
+    std::string type;
+    long long received = 0, rejected = 0, published = 0;
+    std::string last_error;
+  };
+  const std::map<std::string, TopicStats>& stats() const { return stats_; }  // by ROS name
+  long long rejected_total() const;
+  DdsParticipant& dds() { return dds_; }
+  std::string where() const { return "DDS domain " + std::to_string(dds_.domain_id()); }
+  std::vector<std::pair<std::string, std::string>> Details() const;
+
+ private:
+  struct Route {
+    std::string topic, wire, type;
+    MessageDecoder::Type kind;
+  };
+  Ros2NodeOptions o_;
+  msgs::ChannelRoles roles_;
+  DdsParticipant dds_;
+  MessageDecoder decoder_;
+  EventEncoder encoder_;
+  std::vector<Route> routes_;           // by reader index
+  std::map<std::string, int> writers_;  // by ROS name
+  std::map<std::string, std::string> writer_types_;
+  std::map<std::string, TopicStats> stats_;
+  std::vector<EncodedMessage> encoded_;
+  std::vector<msgs::Event>* sink_ = nullptr;
+};
+
+std::unique_ptr<msgs::Source> OpenRos2Live(const msgs::SourceOptions& options);
+msgs::StageType Ros2BridgeStageType();
+
+// [source] type = ros2_live: the node's options and the live keys.
+struct Ros2LiveOptions {
+  Ros2NodeOptions node;
+  msgs::LiveSourceOptions live;
+};
+
+}  // namespace mbot::ros2
