@@ -24,6 +24,8 @@ packages=(
   python3-venv        # tests/ros2: rosbags and mcap (PyPI) in a venv, the independent peers
   libzstd-dev liblz4-dev  # libs/ros2: MCAP chunks compressed with zstd or lz4
   libbz2-dev          # libs/ros2: ROS 1 bags' bz2 chunks
+  cyclonedds-dev      # libs/ros2: ROS 2 on the wire (Eclipse Cyclone DDS, rmw_cyclonedds_cpp's DDS)
+  libfastrtps-dev libfastcdr-dev fastddsgen  # tests/ros2: the other DDS vendor plays the robot
 )
 # tests/viewer's peers run on Node.js: the machine's own when it has one, else Debian's.
 if ! command -v node > /dev/null || ! command -v npm > /dev/null; then packages+=(nodejs npm); fi

@@ -156,6 +156,13 @@ bool MessageDecoder::LidarEvent(const LaserScan& s, const std::string& topic, Ev
   bool mirrored = false;
   std::optional<Pose2D> mount = Mount(s.header.frame_id, &mirrored);
   if (!mount) {
+    // Live, /tf_static comes once discovery has matched its latched writer: scans before it are
+    // held back (dropped, counted) for a while rather than put in the map with a wrong mount.
+    if (first_unmounted_us_ == 0) first_unmounted_us_ = ev->t_us;
+    if (ev->t_us - first_unmounted_us_ < wait_for_mount_us_) {
+      ++scans_waiting_for_mount_;
+      return false;
+    }
     if (warned_.insert("mount:" + s.header.frame_id).second) {
       mbot::log::Warn(where_ + ": " + topic + ": no transform from the robot's frame to the scan's frame '" +
                       s.header.frame_id +
@@ -215,6 +222,8 @@ std::vector<std::pair<std::string, std::string>> MessageDecoder::Details() const
                   m.pose.theta * 180.0 / M_PI, m.mirrored ? ", mounted upside down" : "");
     d.push_back({"lidar " + frame, text});
   }
+  if (scans_waiting_for_mount_ > 0)
+    d.push_back({"scans dropped waiting for /tf_static", std::to_string(scans_waiting_for_mount_)});
   return d;
 }
 

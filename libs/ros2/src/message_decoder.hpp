@@ -51,6 +51,11 @@ class MessageDecoder {
               Serialization serialization, int64_t t_us, const msgs::ChannelRoles& roles, msgs::Event* ev,
               std::string* refused);
 
+  // Scans whose frame /tf_static does not connect yet are dropped for this long after the first
+  // (live: the latched /tf_static arrives once discovery matched its writer); after it, and with 0
+  // (bags), they are taken as mounted at the robot's centre, facing forward, with a warning.
+  void WaitForMount(int64_t us) { wait_for_mount_us_ = us; }
+
   // The lidar mounts found so far, for a summary ("lidar lidar_link": "x 0.000 m, …").
   std::vector<std::pair<std::string, std::string>> Details() const;
 
@@ -67,6 +72,8 @@ class MessageDecoder {
   };
   std::map<std::string, MountCache> mounts_;  // scan frame → its mount, once the tree connects it
   std::set<std::string> warned_;
+  int64_t wait_for_mount_us_ = 0, first_unmounted_us_ = 0;
+  long long scans_waiting_for_mount_ = 0;
 };
 
 }  // namespace mbot::ros2

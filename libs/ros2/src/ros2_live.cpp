@@ -67,6 +67,9 @@ Ros2NodeOptions ParseRos2NodeOptions(config::Section& s, const std::string& url)
   o.robot_frame = s.GetString("robot_frame", o.robot_frame,
                               "ros2: the robot's frame, whose transform to the scan's frame (/tf_static) is the "
                               "lidar's mount ('' = the frame /odom moves, else base_footprint)");
+  o.wait_for_mount_us = static_cast<int64_t>(
+      1e6 * s.GetDouble("wait_for_mount_s", o.wait_for_mount_us * 1e-6,
+                        "ros2: scans are held back this long waiting for /tf_static's lidar mount [s]", 0.0, 60.0));
   o.frames.map = s.GetString("map_frame", o.frames.map, "ros2: the map's frame");
   o.frames.odom = s.GetString("odom_frame", o.frames.odom, "ros2: the odometry's frame");
   o.frames.robot = s.GetString("base_frame", o.frames.robot, "ros2: the robot's frame (odometry's child)");
@@ -94,6 +97,7 @@ Ros2Node::Ros2Node(Ros2NodeOptions options, const std::vector<std::string>& chan
     subscribe(c, o_.topics.Wire(c), type);
   }
   subscribe("/tf_static", "/tf_static", kTFMessageType);
+  decoder_.WaitForMount(o_.wait_for_mount_us);
 }
 
 void Ros2Node::Poll(int timeout_ms, std::vector<Event>* out) {

@@ -27,7 +27,8 @@ struct Ros2NodeOptions {
   DdsOptions dds;
   msgs::TopicTable topics = DefaultTopics();
   Frames frames;
-  std::string robot_frame;  // whose transform to the scan's frame is the lidar's mount ("" = /odom's child)
+  int64_t wait_for_mount_us = 3000000;  // scans without a mount are dropped this long (then: centre)
+  std::string robot_frame;              // whose transform to the scan's frame is the lidar's mount ("" = /odom's child)
   // ROS types of the topics read (pipeline topic → type); the MBot's by default (DefaultRosType).
   std::map<std::string, std::string> types;
 };

@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# The autonomy and the simulated robot as two processes talking ROS 2 over DDS (Cyclone DDS on both
+# sides, the MBot's topics, frames and QoS), inside a private network namespace (loopback up,
+# multicast on it) so no packet leaves the test. `explore`: config/ros2_live.ini explores maze_1
+# through config/sim_robot_ros2.ini; `warehouse`: config/ros2_live_warehouse.ini makes one delivery
+# through config/sim_robot_ros2_warehouse.ini. Asserts the robot's referee saw the mission complete
+# with no collision (explore: coverage ≥ 99 %), the autonomy's mission completed and it rejected
+# nothing. Exits 77 (skipped) where namespaces are not permitted.
+#   over_ros2.sh <mbot_nav> <config dir> <output dir> explore|warehouse [seed]
+set -u
+bin=$1 config=$2 out=$3 task=$4 seed=${5:-2}
+if ! unshare -n true 2>/dev/null; then
+  echo "SKIPPED: cannot create a network namespace here (unshare -n not permitted); the live test needs one"
+  exit 77
+fi
+command -v ip > /dev/null || { echo "SKIPPED: ip is not installed; scripts/install_deps.sh installs it"; exit 77; }
+case $task in
+  explore) autonomy_ini=ros2_live.ini robot_ini=sim_robot_ros2.ini extra="" limit=150 ;;
+  warehouse) autonomy_ini=ros2_live_warehouse.ini robot_ini=sim_robot_ros2_warehouse.ini
+    extra="--set mission.deliveries=1" limit=200 ;;
+  *) echo "over_ros2.sh: task is explore or warehouse, not '$task'"; exit 2 ;;
+esac
+rm -rf "$out" && mkdir -p "$out"
+export bin config out seed autonomy_ini robot_ini extra limit
+unshare -n bash -c '
+  set -u
+  ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo ||
+    { echo "cannot set up loopback multicast"; exit 1; }
+  "$bin" --config "$config/$autonomy_ini" --set output.dir="$out/autonomy" --set source.end_after_silence_s=5 \
+    --set pipeline.seed=$seed $extra --set pipeline.progress=off > "$out/autonomy.log" 2>&1 &
+  autonomy=$!
+  sleep 1  # the autonomy listens before the robot starts publishing
+  # Time limits below ctest'"'"'s 300 s, so a stalled run fails with its logs instead of timing out.
+  "$bin" --config "$config/$robot_ini" --set output.dir="$out/robot" --set pipeline.progress=off \
+    --set pipeline.seed=$seed --set referee.time_limit_s=$limit --set source.duration_s=$((limit + 30)) \
+    > "$out/robot.log" 2>&1
+  robot_rc=$?
+  wait $autonomy
+  autonomy_rc=$?
+  echo "robot exit $robot_rc, autonomy exit $autonomy_rc"
+  exit $(( robot_rc != 0 || autonomy_rc != 0 ))
+'
+rc=$?
+echo "--- robot (simulator + referee)"; tail -12 "$out/robot.log"
+echo "--- autonomy"; grep -E "ros2|mission: (lifting|setting_down|completed|failed)|error" "$out/autonomy.log" | tail -8
+[ $rc -eq 0 ] || { echo "FAIL: a process failed"; exit 1; }
+score="$out/robot/score.json"
+[ -f "$score" ] || { echo "FAIL: no score.json from the robot's referee"; exit 1; }
+fail=0
+grep -q '"completed": true' "$score" || { echo "FAIL: the referee did not see the mission complete"; fail=1; }
+grep -q '"collisions": 0,' "$score" || { echo "FAIL: the robot touched a wall"; fail=1; }
+if [ "$task" = explore ]; then
+  coverage=$(sed -n 's/.*"coverage": \([0-9.]*\).*/\1/p' "$score")
+  awk -v c="$coverage" 'BEGIN { exit !(c >= 0.99) }' || { echo "FAIL: map coverage $coverage < 0.99 (was /map published?)"; fail=1; }
+else
+  stops=$(grep -c '"done_at_s": [0-9]' "$score")
+  [ "$stops" -ge 2 ] || { echo "FAIL: the referee judged $stops stops done, not 2"; fail=1; }
+fi
+grep -q '"state": "completed"' "$out/autonomy/mission.json" || { echo "FAIL: the autonomy's mission did not complete"; fail=1; }
+grep -E "^ros2: [0-9.]+ messages/s" "$out/autonomy.log" | tail -1 | grep -q " 0 rejected" ||
+  { echo "FAIL: the autonomy rejected messages from the simulated robot"; fail=1; }
+[ $fail -eq 0 ] && echo "PASS: $task over ROS 2 (DDS), no collision"
+exit $fail

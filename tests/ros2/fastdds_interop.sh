@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Cross-vendor ROS 2: mbot_nav's autonomy (config/ros2_live.ini, Cyclone DDS) against a robot played
+# by Fast DDS (tests/ros2/fastdds_peer: fastddsgen's types from IDL written from the public .msg
+# files), inside a private network namespace (loopback up, multicast on it) so no packet leaves the
+# test. The peer publishes /tf_static, /odom and /scan for 8 s and asserts that a non-zero /cmd_vel
+# comes back and that a late-joining reader gets /map with the room where the mount puts it.
+#   fastdds_interop.sh <mbot_nav> <mbot_fastdds_peer> <config dir> <output dir>
+set -u
+bin=$1 peer=$2 config=$3 out=$4
+if ! unshare -n true 2>/dev/null; then
+  echo "SKIPPED: cannot create a network namespace here (unshare -n not permitted)"
+  exit 77
+fi
+command -v ip > /dev/null || { echo "SKIPPED: ip (iproute2) is not installed; scripts/install_deps.sh installs it"; exit 77; }
+rm -rf "$out" && mkdir -p "$out"
+export bin peer config out
+unshare -n bash -c '
+  set -u
+  ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo || exit 1
+  "$bin" --config "$config/ros2_live.ini" --set output.dir="$out/autonomy" --set source.end_after_silence_s=3 \
+    --set source.duration_s=60 --set pipeline.progress=off > "$out/autonomy.log" 2>&1 &
+  autonomy=$!
+  sleep 1  # the autonomy listens before the robot starts
+  "$peer" 0 8 > "$out/peer.log" 2>&1
+  peer_rc=$?
+  wait $autonomy
+  autonomy_rc=$?
+  echo "peer exit $peer_rc, autonomy exit $autonomy_rc"
+  exit $(( peer_rc != 0 || autonomy_rc != 0 ))
+'
+rc=$?
+echo "--- Fast DDS peer"; cat "$out/peer.log"
+echo "--- autonomy"; grep -E "ros2|error" "$out/autonomy.log" | tail -6
+[ $rc -eq 0 ] || { echo "FAIL"; exit 1; }
+grep -q "0 rejected" "$out/autonomy.log" || { echo "FAIL: the autonomy rejected messages of the Fast DDS peer"; exit 1; }
+echo PASS

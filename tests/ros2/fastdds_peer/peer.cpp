@@ -1,0 +1,189 @@
+// A robot on ROS 2 played by eProsima Fast DDS (the other DDS vendor; its types from fastddsgen on
+// mbot_ros2.idl), against mbot_nav's Cyclone DDS transport: for a few seconds it publishes what the
+// MBot publishes — /tf_static (base_footprint → lidar_link, the lidar turned 180° as on the MBot;
+// reliable, transient local), /odom (25 Hz) and /scan (10 Hz) of a 3 m square room with a gap in
+// its +x wall — and listens to /cmd_vel. Then a reader that joins late asks for /map (reliable,
+// transient local). It exits 0 when the stack commanded a non-zero velocity and the late reader got
+// a map in which the wall at −x is occupied and the gap at +x is not (the mount was applied).
+//   mbot_fastdds_peer <domain id> <seconds>
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <thread>
+
+#include "mbot_ros2PubSubTypes.h"
+
+using namespace eprosima::fastdds::dds;
+namespace geo = geometry_msgs::msg::dds_;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+builtin_interfaces::msg::dds_::Time_ Now() {
+  const auto ns =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  builtin_interfaces::msg::dds_::Time_ t;
+  t.sec(static_cast<int32_t>(ns / 1000000000));
+  t.nanosec(static_cast<uint32_t>(ns % 1000000000));
+  return t;
+}
+
+// The room: walls at x = ±1.5 and y = ±1.5 m, the +x wall open for |y| < 0.4 m. The distance from
+// the centre along a robot-frame bearing, or infinity through the gap.
+float Range(double bearing) {
+  const double c = std::cos(bearing), s = std::sin(bearing);
+  double t = 1e9;
+  if (std::abs(c) > 1e-9) {
+    const double tx = 1.5 / std::abs(c);
+    const double y = s * tx;
+    if (!(c > 0 && std::abs(y) < 0.4)) t = std::min(t, tx);
+  }
+  if (std::abs(s) > 1e-9) t = std::min(t, 1.5 / std::abs(s));
+  return t < 12.0 ? static_cast<float>(t) : INFINITY;
+}
+
+template <typename T>
+struct Endpoint {
+  Topic* topic = nullptr;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int domain = argc > 1 ? std::atoi(argv[1]) : 0;
+  const double seconds = argc > 2 ? std::atof(argv[2]) : 8.0;
+  DomainParticipant* pp = DomainParticipantFactory::get_instance()->create_participant(domain, PARTICIPANT_QOS_DEFAULT);
+  if (!pp) return std::fprintf(stderr, "peer: no participant\n"), 2;
+  TypeSupport scan_t(new sensor_msgs::msg::dds_::LaserScan_PubSubType());
+  TypeSupport odom_t(new nav_msgs::msg::dds_::Odometry_PubSubType());
+  TypeSupport tf_t(new tf2_msgs::msg::dds_::TFMessage_PubSubType());
+  TypeSupport twist_t(new geo::Twist_PubSubType());
+  TypeSupport map_t(new nav_msgs::msg::dds_::OccupancyGrid_PubSubType());
+  for (TypeSupport* t : {&scan_t, &odom_t, &tf_t, &twist_t, &map_t}) t->register_type(pp);
+  Topic* scan_topic = pp->create_topic("rt/scan", scan_t.get_type_name(), TOPIC_QOS_DEFAULT);
+  Topic* odom_topic = pp->create_topic("rt/odom", odom_t.get_type_name(), TOPIC_QOS_DEFAULT);
+  Topic* tf_topic = pp->create_topic("rt/tf_static", tf_t.get_type_name(), TOPIC_QOS_DEFAULT);
+  Topic* cmd_topic = pp->create_topic("rt/cmd_vel", twist_t.get_type_name(), TOPIC_QOS_DEFAULT);
+  Topic* map_topic = pp->create_topic("rt/map", map_t.get_type_name(), TOPIC_QOS_DEFAULT);
+  Publisher* pub = pp->create_publisher(PUBLISHER_QOS_DEFAULT);
+  Subscriber* sub = pp->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+
+  DataWriterQos reliable = DATAWRITER_QOS_DEFAULT;
+  reliable.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  reliable.history().depth = 10;
+  DataWriterQos latched = reliable;
+  latched.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
+  latched.history().depth = 1;
+  DataWriter* scan_w = pub->create_datawriter(scan_topic, reliable);
+  DataWriter* odom_w = pub->create_datawriter(odom_topic, reliable);
+  DataWriter* tf_w = pub->create_datawriter(tf_topic, latched);
+  DataReaderQos cmd_q = DATAREADER_QOS_DEFAULT;
+  cmd_q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  DataReader* cmd_r = sub->create_datareader(cmd_topic, cmd_q);
+  if (!scan_w || !odom_w || !tf_w || !cmd_r) return std::fprintf(stderr, "peer: endpoints not created\n"), 2;
+
+  // The lidar's mount, as robot_state_publisher says it: z 0.142 m, yaw 180° (z axis up).
+  tf2_msgs::msg::dds_::TFMessage_ tf;
+  geo::TransformStamped_ mount;
+  mount.header().stamp(Now());
+  mount.header().frame_id("base_footprint");
+  mount.child_frame_id("lidar_link");
+  mount.transform().translation().z(0.142);
+  mount.transform().rotation().z(1.0);
+  mount.transform().rotation().w(0.0);
+  tf.transforms().push_back(mount);
+  tf_w->write(&tf);
+
+  const auto start = Clock::now();
+  auto next_scan = start, next_odom = start;
+  long scans = 0, odoms = 0, commands = 0, moving = 0;
+  while (Clock::now() - start < std::chrono::duration<double>(seconds)) {
+    const auto now = Clock::now();
+    if (now >= next_odom) {
+      nav_msgs::msg::dds_::Odometry_ o;
+      o.header().stamp(Now());
+      o.header().frame_id("odom");
+      o.child_frame_id("base_footprint");
+      o.pose().pose().orientation().w(1.0);
+      odom_w->write(&o);
+      ++odoms;
+      next_odom += std::chrono::milliseconds(40);
+    }
+    if (now >= next_scan) {
+      sensor_msgs::msg::dds_::LaserScan_ s;
+      s.header().stamp(Now());
+      s.header().frame_id("lidar_link");
+      const int n = 360;
+      s.angle_min(static_cast<float>(-M_PI));
+      s.angle_increment(static_cast<float>(2 * M_PI / n));
+      s.angle_max(static_cast<float>(-M_PI + 2 * M_PI / n * (n - 1)));
+      s.scan_time(0.1f);
+      s.range_min(0.15f);
+      s.range_max(12.0f);
+      for (int i = 0; i < n; ++i) s.ranges().push_back(Range(-M_PI + 2 * M_PI / n * i + M_PI));  // lidar → robot
+      scan_w->write(&s);
+      ++scans;
+      next_scan += std::chrono::milliseconds(100);
+    }
+    geo::Twist_ t;
+    SampleInfo info;
+    while (cmd_r->take_next_sample(&t, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      ++commands;
+      if (std::abs(t.linear().x()) > 1e-6 || std::abs(t.angular().z()) > 1e-6) ++moving;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  std::printf("peer: published %ld scans, %ld odometry; received %ld /cmd_vel (%ld non-zero)\n", scans, odoms, commands,
+              moving);
+
+  // A reader that joins late: /map comes from the writer's history (transient local).
+  DataReaderQos map_q = DATAREADER_QOS_DEFAULT;
+  map_q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  map_q.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
+  DataReader* map_r = sub->create_datareader(map_topic, map_q);
+  bool got_map = false, wall_seen = false, gap_open = false;
+  const auto wait_end = Clock::now() + std::chrono::seconds(5);
+  while (!got_map && Clock::now() < wait_end) {
+    nav_msgs::msg::dds_::OccupancyGrid_ g;
+    SampleInfo info;
+    while (map_r && map_r->take_next_sample(&g, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      got_map = true;
+      const auto& m = g.info();
+      auto cell = [&](double x, double y) {
+        const int cx = static_cast<int>(std::floor((x - m.origin().position().x()) / m.resolution()));
+        const int cy = static_cast<int>(std::floor((y - m.origin().position().y()) / m.resolution()));
+        if (cx < 0 || cy < 0 || cx >= static_cast<int>(m.width()) || cy >= static_cast<int>(m.height())) return -2;
+        return static_cast<int>(g.data()[static_cast<size_t>(cy) * m.width() + cx]);
+      };
+      // Occupied somewhere on the −x wall near y = 0; nothing occupied in the +x gap.
+      for (double y = -0.2; y <= 0.2; y += m.resolution()) {
+        for (double x = -1.6; x <= -1.4; x += m.resolution()) wall_seen = wall_seen || cell(x, y) == 100;
+      }
+      gap_open = true;
+      for (double y = -0.2; y <= 0.2; y += m.resolution()) {
+        for (double x = 1.4; x <= 1.6; x += m.resolution()) gap_open = gap_open && cell(x, y) != 100;
+      }
+      std::printf("peer: late reader got /map %ux%u at %.3f m (wall at -x %s, gap at +x %s)\n", m.width(), m.height(),
+                  m.resolution(), wall_seen ? "occupied" : "NOT occupied", gap_open ? "open" : "CLOSED");
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  pp->delete_contained_entities();
+  DomainParticipantFactory::get_instance()->delete_participant(pp);
+  const bool ok = moving > 0 && got_map && wall_seen && gap_open;
+  std::printf("%s\n", ok ? "PASS" : "FAIL: no non-zero /cmd_vel, or no /map for the late reader, or a wrong map");
+  return ok ? 0 : 1;
+}
