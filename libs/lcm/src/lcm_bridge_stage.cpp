@@ -10,6 +10,7 @@
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/lcm/lcm_live.hpp"
+#include "mbot/msgs/loop_latency.hpp"
 #include "mbot/msgs/stage.hpp"
 #include "mbot/msgs/topics.hpp"
 
@@ -40,17 +41,23 @@ class LcmBridgeStage : public Stage {
   }
 
   void OnEvent(const Event& ev) override {
-    if (publish_.count(ev.channel)) node_->Publish(ev);
+    if (publish_.count(ev.channel) && node_->Publish(ev) && ev.kind == EventKind::kLidar)
+      latency_.ScanSent(WallClockUs());
     std::vector<Event> got;
     node_->Poll(0, &got);
     for (Event& in : got) {
+      if (in.kind == EventKind::kMotorCommand) latency_.CommandReceived(in.t_us);
       in.t_us = ev.t_us;  // into this pipeline's (the simulation's) time
       if (bus_) bus_->Emit(this, in);
     }
   }
 
-  void Finish(const RunContext& /*ctx*/, bool /*interrupted*/) override {
+  void Finish(const RunContext& ctx, bool /*interrupted*/) override {
     if (!node_) return;
+    if (const std::string l = latency_.Summary(); !l.empty()) {
+      mbot::log::Info("lcm_bridge: scan out → command back: " + l);
+      latency_.WriteJson(ctx.output_dir + "/loop_latency.json", "lcm");
+    }
     std::string counts;
     for (const auto& [channel, s] : node_->stats()) {
       counts += (counts.empty() ? "" : ", ") + channel + " " + std::to_string(s.received) + " in / " +
@@ -65,6 +72,7 @@ class LcmBridgeStage : public Stage {
   std::set<std::string> publish_;
   Bus* bus_ = nullptr;
   std::unique_ptr<LcmNode> node_;
+  LoopLatency latency_;
 };
 
 }  // namespace

@@ -6,6 +6,7 @@
 
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
+#include "mbot/msgs/loop_latency.hpp"
 #include "mbot/msgs/topics.hpp"
 
 namespace mbot::ros2 {
@@ -240,17 +241,23 @@ class Ros2BridgeStage : public msgs::Stage {
   }
 
   void OnEvent(const Event& ev) override {
-    if (publish_.count(ev.channel)) node_->Publish(ev);
+    if (publish_.count(ev.channel) && node_->Publish(ev) && ev.kind == EventKind::kLidar)
+      latency_.ScanSent(msgs::WallClockUs());
     got_.clear();
     node_->Poll(0, &got_);
     for (Event& in : got_) {
+      if (in.kind == EventKind::kMotorCommand) latency_.CommandReceived(in.t_us);
       in.t_us = ev.t_us;  // into this pipeline's (the simulation's) time
       if (bus_) bus_->Emit(this, in);
     }
   }
 
-  void Finish(const msgs::RunContext& /*ctx*/, bool /*interrupted*/) override {
+  void Finish(const msgs::RunContext& ctx, bool /*interrupted*/) override {
     if (!node_) return;
+    if (const std::string l = latency_.Summary(); !l.empty()) {
+      mbot::log::Info("ros2_bridge: scan out → command back: " + l);
+      latency_.WriteJson(ctx.output_dir + "/loop_latency.json", "ros2");
+    }
     std::string counts;
     for (const auto& [wire, s] : node_->stats()) {
       counts += (counts.empty() ? "" : ", ") + wire + " " + std::to_string(s.received) + " in / " +
@@ -266,6 +273,7 @@ class Ros2BridgeStage : public msgs::Stage {
   msgs::Bus* bus_ = nullptr;
   std::unique_ptr<Ros2Node> node_;
   std::vector<Event> got_;
+  msgs::LoopLatency latency_;
 };
 
 }  // namespace
