@@ -1,8 +1,10 @@
 // mbot_nav: parse arguments, load the configuration, build the pipeline, run it, report.
 #include <csignal>
+#include <unistd.h>
 #include <filesystem>
 #include <cstring>
 #include <iostream>
+#include <cstdlib>
 #include <optional>
 
 #include "mbot/common/config.hpp"
@@ -172,6 +174,12 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  if (!competition && mbot::pipeline::SourceIsABus(plan) && !std::getenv("OMP_WAIT_POLICY")) {
+    // A robot's bus: OpenMP threads sleep between scans (pipeline.hpp says why). The policy is read
+    // when libgomp loads, so the process starts again with it; if that fails it runs as it is.
+    setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
+    execv("/proc/self/exe", argv);
+  }
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
   if (competition) {

@@ -238,6 +238,11 @@ PipelinePlan BuildPlan(const config::Config& config) {
   return plan;
 }
 
+bool SourceIsABus(const PipelinePlan& plan) {
+  const msgs::SourceType* t = msgs::FindSourceType(plan.source.type);
+  return t && !t->default_url.empty();
+}
+
 RunSummary RunPlan(PipelinePlan& plan, const std::atomic<bool>& stop) {
   RunSummary summary;
   const auto wall0 = std::chrono::steady_clock::now();

@@ -9,6 +9,7 @@
 #include <dds/ddsi/q_radmin.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstring>
 #include <map>
 #include <stdexcept>
@@ -35,7 +36,12 @@ struct RawType : ddsi_sertype {
 };
 struct RawSample : ddsi_serdata {
   std::vector<uint8_t> bytes;  // the CDR payload, with its encapsulation header
+  int64_t arrival_us = 0;      // when Cyclone's receive thread got it (wall clock)
 };
+int64_t NowUs() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
 struct Blob {  // what dds_write takes
   const uint8_t* data;
   size_t size;
@@ -60,6 +66,7 @@ uint32_t GetSize(const ddsi_serdata* d) {
 ddsi_serdata* FromSer(const ddsi_sertype* type, ddsi_serdata_kind kind, const nn_rdata* frag, size_t size) {
   if (TooLarge(type, size)) return nullptr;  // Cyclone drops a sample it cannot deserialize
   RawSample* d = NewSample(type, kind);
+  d->arrival_us = NowUs();
   d->bytes.resize(size);
   uint32_t off = 0;
   for (; frag; frag = frag->nextfrag) {  // fragments in order; they may overlap
@@ -75,6 +82,7 @@ ddsi_serdata* FromSerIov(const ddsi_sertype* type, ddsi_serdata_kind kind, ddsrt
                          const ddsrt_iovec_t* iov, size_t size) {
   if (TooLarge(type, size)) return nullptr;
   RawSample* d = NewSample(type, kind);
+  d->arrival_us = NowUs();
   d->bytes.reserve(size);
   for (ddsrt_msg_iovlen_t i = 0; i < niov; ++i) {
     const auto* p = static_cast<const uint8_t*>(iov[i].iov_base);
@@ -264,7 +272,8 @@ void DdsParticipant::Take(int timeout_ms, const std::function<void(const Sample&
       for (dds_return_t k = 0; k < n; ++k) {
         const auto* s = static_cast<const RawSample*>(got[k]);
         if (info[k].valid_data && !s->bytes.empty())
-          on_sample({static_cast<int>(i), s->bytes.data(), s->bytes.size(), info[k].source_timestamp / 1000});
+          on_sample({static_cast<int>(i), s->bytes.data(), s->bytes.size(), info[k].source_timestamp / 1000,
+                     s->arrival_us ? s->arrival_us : NowUs()});
         ddsi_serdata_unref(got[k]);
       }
       if (static_cast<uint32_t>(n) < kBatch) break;

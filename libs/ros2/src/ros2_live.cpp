@@ -107,7 +107,7 @@ void Ros2Node::Poll(int timeout_ms, std::vector<Event>* out) {
     TopicStats& st = stats_[r.wire];
     ++st.received;
     Event ev;
-    ev.t_us = msgs::WallClockUs();
+    ev.t_us = s.arrival_us;  // when the receive thread got it (what LCM's recv_utime is)
     ev.channel = r.topic;
     std::string refused, error;
     bool got = false;

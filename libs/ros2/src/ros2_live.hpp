@@ -44,7 +44,7 @@ class Ros2Node {
   // std::runtime_error naming a channel with no known ROS type or a topic DDS refuses.
   Ros2Node(Ros2NodeOptions options, const std::vector<std::string>& channels, const msgs::ChannelRoles& roles);
 
-  // Waits up to timeout_ms, then takes what arrived: events in arrival order, t_us = when taken.
+  // Waits up to timeout_ms, then takes what arrived: events in arrival order, t_us = when DDS received them.
   void Poll(int timeout_ms, std::vector<msgs::Event>* out);
   // Publishes the messages the event becomes (a writer per topic, made on first use with the
   // topic's QoS); false when it has none.

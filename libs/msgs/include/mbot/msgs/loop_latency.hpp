@@ -19,8 +19,10 @@ class LoopLatency {
   void ScanSent(int64_t wall_us) {
     if (pending_us_ == 0) pending_us_ = wall_us;  // the oldest scan not yet answered
   }
+  // `wall_us`: when the transport received it (a command that arrived before the scan went out
+  // answers an earlier one).
   void CommandReceived(int64_t wall_us) {
-    if (pending_us_ == 0) return;
+    if (pending_us_ == 0 || wall_us < pending_us_) return;
     if (samples_ms_.size() < kMaxSamples) samples_ms_.push_back((wall_us - pending_us_) * 1e-3);
     pending_us_ = 0;
   }

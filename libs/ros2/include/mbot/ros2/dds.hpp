@@ -48,6 +48,7 @@ class DdsParticipant {
     const uint8_t* data;  // the CDR payload, with its encapsulation header
     size_t size;
     int64_t source_time_us;  // the writer's timestamp
+    int64_t arrival_us;      // when Cyclone's receive thread got it (wall clock, µs since the epoch)
   };
   // Waits up to timeout_ms for data on any reader, then takes every sample waiting on all of them.
   void Take(int timeout_ms, const std::function<void(const Sample&)>& on_sample);
