@@ -124,8 +124,7 @@ void Ros2Node::Poll(int timeout_ms, std::vector<Event>* out) {
       st.last_error = error;
       mbot::log::WarnOnce("ros2:rejected:" + r.wire,
                           "ros2: " + r.wire + ": malformed message rejected (" + error + "); further ones are counted");
-      if (!got || !refused.empty()) return;
-      if (!msgs::IsPlausibleTimeUs(ev.stamp_us)) return;
+      return;  // nothing of a rejected message goes on
     }
     if (got && ev.kind != EventKind::kOther) out->push_back(std::move(ev));
   });
