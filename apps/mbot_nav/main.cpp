@@ -161,6 +161,13 @@ int main(int argc, char** argv) {
       mbot::app::WriteSweepJobs(config, SelfPath(argv[0]));
       return 0;
     }
+    if (!mbot::app::IsCompetition(config) && mbot::pipeline::SourceIsABus(config) && !std::getenv("OMP_WAIT_POLICY")) {
+      // A robot's bus: OpenMP threads sleep between scans (pipeline.hpp says why). The policy is read
+      // when libgomp loads, so the process starts again with it, before any of the plan is built; if
+      // that fails it runs as it is.
+      setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
+      execv("/proc/self/exe", argv);
+    }
     if (mbot::app::IsCompetition(config)) {
       competition = mbot::app::BuildCompetition(config);
     } else {
@@ -174,12 +181,6 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  if (!competition && mbot::pipeline::SourceIsABus(plan) && !std::getenv("OMP_WAIT_POLICY")) {
-    // A robot's bus: OpenMP threads sleep between scans (pipeline.hpp says why). The policy is read
-    // when libgomp loads, so the process starts again with it; if that fails it runs as it is.
-    setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
-    execv("/proc/self/exe", argv);
-  }
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
   if (competition) {

@@ -171,14 +171,19 @@ void WriteRos1Seeds(const fs::path& dir, const std::string& from) {
   if (n == 0) return;
   const uint8_t* p = d + 1;
   const size_t size = n - 1;
-  switch (d[0] % 7) {
+  switch (d[0] % 12) {
     case 0: DecodeLaserScan(p, size); break;
     case 1: DecodeOdometry(p, size); break;
     case 2: DecodeImu(p, size); break;
     case 3: DecodeTwist(p, size); break;
     case 4: DecodeTFMessage(p, size); break;
     case 5: DecodePoseStamped(p, size); break;
-    default: DecodePoseWithCovarianceStamped(p, size); break;
+    case 6: DecodePoseWithCovarianceStamped(p, size); break;
+    case 7: DecodeOccupancyGrid(p, size); break;
+    case 8: DecodeString(p, size); break;
+    case 9: DecodeEncoders(p, size); break;
+    case 10: DecodeMotorVelocity(p, size); break;
+    default: DecodeAprilTagDetectionArray(p, size); break;
   }
 }
 

@@ -121,16 +121,9 @@ std::vector<Tag> ReadExpected(const std::string& path) {
 
 cv::Point2d Centre(const Tag& t) { return (t.corners[0] + t.corners[1] + t.corners[2] + t.corners[3]) / 4.0; }
 
-// At the library's own test settings (decimate 1, no edge refinement): every tag, with its id, no
-// other detection, each corner within 0.25 px of the library's expected corner (its own suite asks
-// 0.1 px with its own JPEG reader).
-TEST(VisionRegression, TagDetectionFindsEveryTagOfTheLibrarysTestPhoto) {
-  const std::string csv = RunConfig("detect_tags.ini", "detect_tags_reference",
-                                    {"detect.decimate=1", "detect.refine_edges=false"}, "tags.csv");
-  const std::vector<Tag> got = ReadTags(csv);
-  const std::vector<Tag> expected = ReadExpected(Data("camera/apriltag/33369213973_9d9bb4cc96_c.txt"));
-  ASSERT_EQ(expected.size(), 12u);
-  ASSERT_EQ(got.size(), expected.size()) << csv;
+// The worst corner error of the tags in `csv` against the library's expected ones (matched by
+// centre; each expected tag to its own detection, with the same id).
+double WorstCornerError(const std::vector<Tag>& got, const std::vector<Tag>& expected) {
   double worst = 0.0;
   std::vector<bool> used(got.size(), false);
   for (const Tag& e : expected) {
@@ -143,8 +136,32 @@ TEST(VisionRegression, TagDetectionFindsEveryTagOfTheLibrarysTestPhoto) {
     EXPECT_EQ(got[best].id, e.id);
     for (int k = 0; k < 4; ++k) worst = std::max(worst, cv::norm(got[best].corners[k] - e.corners[k]));
   }
-  EXPECT_LE(worst, 0.25);
-  RecordProperty("worst_corner_error_px", std::to_string(worst));
+  return worst;
+}
+
+// At the library's own test settings (decimate 1, no edge refinement), on each photo of its own
+// suite: every tag, with its id, no other detection, each corner within 0.25 px of the library's
+// expected corner. (Its own suite asks 0.1 px with its own JPEG reader; Debian's build, fed the
+// JPEG's luma, stays within 0.14 px. A colour decode converted to grey gave up to 0.305 px.)
+TEST(VisionRegression, TagCornersMatchTheLibrarysOwnTestSuite) {
+  const std::string suite = std::string(MBOT_SOURCE_DIR) + "/tests/vision/apriltag_suite/";
+  const std::vector<std::pair<std::string, size_t>> photos = {{Data("camera/apriltag/33369213973_9d9bb4cc96_c"), 12},
+                                                              {suite + "34085369442_304b6bafd9_c", 25},
+                                                              {suite + "34139872896_defdb2f8d9_c", 10}};
+  for (const auto& [photo, count] : photos) {
+    SCOPED_TRACE(photo);
+    const std::string name = std::filesystem::path(photo).filename().string();
+    const std::string csv =
+        RunConfig("detect_tags.ini", "detect_tags_reference_" + name,
+                  {"source.path=" + photo + ".jpg", "detect.decimate=1", "detect.refine_edges=false"}, "tags.csv");
+    const std::vector<Tag> got = ReadTags(csv);
+    const std::vector<Tag> expected = ReadExpected(photo + ".txt");
+    ASSERT_EQ(expected.size(), count);
+    ASSERT_EQ(got.size(), expected.size()) << csv;
+    const double worst = WorstCornerError(got, expected);
+    EXPECT_LE(worst, 0.25);
+    RecordProperty("worst_corner_error_px_" + name, std::to_string(worst));
+  }
   // The shipped config (decimate 1, edges refined) finds them all too.
   EXPECT_EQ(ReadTags(RunConfig("detect_tags.ini", "detect_tags_default", {}, "tags.csv")).size(), 12u);
 }

@@ -8,6 +8,7 @@
    the rosbag2 metadata record are as rosbag2 writes them; the content is the run's (the scans, the
    last pose of slam.tum, the map's size).
 2. The simulated Maze Explorer stopped with Ctrl-C a few seconds in: the bag is still whole.
+3. Heavy Lift's camera tags, as apriltag_ros publishes them: /detections and the tags on /tf.
 
     recorder_interop.py <mbot_nav> <config dir> <work dir>   (MBOT_DATASETS_DIR: the datasets)
 """
@@ -60,6 +61,7 @@ def open_with_rosbags(bag):
     # The MBot's own message, from mbot_interfaces/msg/Encoders.msg of the firmware's generation.
     ts.register(get_types_from_msg("builtin_interfaces/Time stamp\nint64[3] ticks\nint32[3] delta_ticks\n"
                                    "int32 delta_time\n", "mbot_interfaces/msg/Encoders"))
+    ts.register(get_types_from_msg("float32[3] velocity\n", "mbot_interfaces/msg/MotorVelocity"))
     counts, last, qos = {}, {}, {}
     with AnyReader([bag], default_typestore=ts) as reader:
         for connection, _t, raw in reader.messages():
@@ -152,7 +154,8 @@ if (sim / "run.mcap").exists():
     check(r2 == c2, "rosbags and Foxglove's reader read the same messages of the exploration")
     for topic, msgtype in (("/frontier_markers", "visualization_msgs/msg/MarkerArray"),
                            ("/mission_state", "std_msgs/msg/String"), ("/planned_path", "nav_msgs/msg/Path"),
-                           ("/encoders", "mbot_interfaces/msg/Encoders")):
+                           ("/encoders", "mbot_interfaces/msg/Encoders"),
+                           ("/motor_vel", "mbot_interfaces/msg/MotorVelocity")):
         check(r2.get(topic, 0) > 0, f"{topic} recorded ({r2.get(topic, 0)}, {msgtype})")
     if "/frontier_markers" in last2:
         markers = last2["/frontier_markers"].markers
@@ -161,6 +164,45 @@ if (sim / "run.mcap").exists():
     if "/mission_state" in last2:
         check(last2["/mission_state"].data.split(":")[0] in ("initializing", "exploring", "returning_home"),
               f"/mission_state says {last2['/mission_state'].data!r}")
+# 3. Heavy Lift's first 20 s on the simulator: the camera's tags as apriltag_ros publishes them,
+#    /detections (apriltag_msgs/AprilTagDetectionArray) and each tag's pose on /tf. rosbags decodes
+#    them with the types of apriltag_msgs' own .msg files (Jazzy's 2.0), Foxglove's reader with the
+#    schema in the file.
+lift = work / "heavy_lift"
+p = subprocess.run([mbot_nav, "--config", config / "heavy_lift.ini", "--set", f"output.dir={lift}",
+                    "--set", "pipeline.progress=off", "--set", "record.format=mcap", "--set", "source.duration_s=20",
+                    "--set", "referee.time_limit_s=20"], capture_output=True, text=True)
+print(p.stdout[-400:] + p.stderr[-400:])
+check(p.returncode == 0, f"the recorded Heavy Lift run exited 0 ({p.returncode})")
+if (lift / "run.mcap").exists():
+    _h, _s, c3, fox3, _m = open_with_foxglove(lift)
+    ts = get_typestore(Stores.ROS2_JAZZY)
+    ts.register(get_types_from_msg("float64 x\nfloat64 y\n", "apriltag_msgs/msg/Point"))
+    ts.register(get_types_from_msg("string family\nint32 id\nint32 hamming\nfloat32 goodness\nfloat32 decision_margin\n"
+                                   "Point centre\nPoint[4] corners\nfloat64[9] homography\n",
+                                   "apriltag_msgs/msg/AprilTagDetection"))
+    ts.register(get_types_from_msg("std_msgs/Header header\nAprilTagDetection[] detections\n",
+                                   "apriltag_msgs/msg/AprilTagDetectionArray"))
+    seen, tag_frames, arrays = [], set(), 0
+    with AnyReader([lift], default_typestore=ts) as reader:
+        for c, _t, raw in reader.messages(connections=[x for x in reader.connections if x.topic in ("/detections", "/tf")]):
+            m = reader.deserialize(raw, c.msgtype)
+            if c.topic == "/detections":
+                arrays += 1
+                seen += list(m.detections)
+            else:
+                tag_frames |= {t.child_frame_id for t in m.transforms if t.child_frame_id.startswith("tag36h11:")}
+    check(arrays > 0 and arrays == c3.get("/detections", 0),
+          f"/detections: {arrays} arrays (one per camera frame), as Foxglove's reader counts")
+    check(len(seen) > 0 and all(d.family == "tag36h11" for d in seen), f"{len(seen)} tag detections, family tag36h11")
+    inside = all(0 <= k.x < 640 and 0 <= k.y < 480 for d in seen for k in d.corners)
+    check(seen and inside and all(abs(d.homography[8]) > 0 for d in seen) and all(d.decision_margin > 0 for d in seen),
+          "every detection's corners lie in the 640×480 image, with its homography and decision margin")
+    ids = sorted({d.id for d in seen})
+    check(seen and tag_frames == {f"tag36h11:{i}" for i in ids},
+          f"each tag's pose on /tf as apriltag_ros names it ({sorted(tag_frames)})")
+    last = fox3.get("/detections")
+    check(last is not None and last.header.frame_id == "camera", "mcap-ros2-support decodes /detections (frame camera)")
 if failures:
     print(f"{len(failures)} check(s) failed")
     sys.exit(1)

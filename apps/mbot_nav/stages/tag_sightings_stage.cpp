@@ -59,7 +59,20 @@ class TagSightingsStage : public Stage {
     msgs::TagSightings out;
     for (const vision::ObservedTag& t : tags) {
       const auto& q = t.quaternion;
-      out.tags.push_back({t.detection.id, t.camera.t[0], t.camera.t[1], t.camera.t[2], q[0], q[1], q[2], q[3]});
+      msgs::TagSighting seen;
+      seen.id = t.detection.id;
+      seen.x_m = t.camera.t[0], seen.y_m = t.camera.t[1], seen.z_m = t.camera.t[2];
+      seen.qw = q[0], seen.qx = q[1], seen.qy = q[2], seen.qz = q[3];
+      seen.family = o_.observer.detector.family;
+      seen.hamming = t.detection.hamming;
+      seen.margin = t.detection.margin;
+      seen.centre_px = {t.detection.center.x, t.detection.center.y};
+      for (int k = 0; k < 4; ++k) {
+        seen.corners_px[2 * k] = t.detection.corners[k].x;
+        seen.corners_px[2 * k + 1] = t.detection.corners[k].y;
+      }
+      seen.homography = t.detection.homography;
+      out.tags.push_back(std::move(seen));
       ++per_id_[t.detection.id];
       char row[320];
       std::snprintf(row, sizeof row, "%.6f,%s,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.2f,%.3f,%.2f\n", ev.t_us * 1e-6,

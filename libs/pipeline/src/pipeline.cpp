@@ -238,8 +238,11 @@ PipelinePlan BuildPlan(const config::Config& config) {
   return plan;
 }
 
-bool SourceIsABus(const PipelinePlan& plan) {
-  const msgs::SourceType* t = msgs::FindSourceType(plan.source.type);
+bool SourceIsABus(const config::Config& config) {
+  if (!config.HasSection("source")) return false;
+  config::Section s = config.GetSection("source");  // a copy: the plan's own reading checks the keys
+  if (!s.Has("type")) return false;
+  const msgs::SourceType* t = msgs::FindSourceType(s.GetString("type", "auto", "input format"));
   return t && !t->default_url.empty();
 }
 

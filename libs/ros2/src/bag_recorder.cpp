@@ -47,7 +47,8 @@ Qos DefaultQos(const std::string& topic) {
 
 BagRecorder::BagRecorder(BagRecorderOptions options)
     : o_(std::move(options)),
-      encoder_(o_.topics, {o_.map_frame, o_.odom_frame, o_.robot_frame, o_.lidar_frame, o_.imu_frame}) {}
+      encoder_(o_.topics,
+               {o_.map_frame, o_.odom_frame, o_.robot_frame, o_.lidar_frame, o_.imu_frame, o_.camera_frame}) {}
 BagRecorder::~BagRecorder() = default;
 
 void BagRecorder::Open(const msgs::RunContext& ctx) {
@@ -161,6 +162,7 @@ BagRecorderOptions ParseBagRecorderOptions(config::Section& s) {
   o.robot_frame = s.GetString("robot_frame", o.robot_frame, "rosbag2: the robot's frame (odometry's child)");
   o.lidar_frame = s.GetString("lidar_frame", o.lidar_frame, "rosbag2: the scans' frame");
   o.imu_frame = s.GetString("imu_frame", o.imu_frame, "rosbag2: the IMU's frame");
+  o.camera_frame = s.GetString("camera_frame", o.camera_frame, "rosbag2: the camera image's frame (tag detections)");
   return o;
 }
 

@@ -28,7 +28,7 @@ struct BagRecorderOptions {
   std::string compression = "zstd";
   msgs::TopicTable topics = DefaultTopics();
   std::string map_frame = "map", odom_frame = "odom", robot_frame = "base_footprint";
-  std::string lidar_frame = "lidar_link", imu_frame = "base_link";
+  std::string lidar_frame = "lidar_link", imu_frame = "base_link", camera_frame = "camera";
 };
 BagRecorderOptions ParseBagRecorderOptions(config::Section& section);
 

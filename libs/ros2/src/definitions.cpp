@@ -73,6 +73,16 @@ const std::map<std::string, Def>& Defs() {
       {"mbot_interfaces/Encoders",
        {"builtin_interfaces/Time stamp\nint64[3] ticks\nint32[3] delta_ticks\nint32 delta_time\n",
         {"builtin_interfaces/Time"}}},
+      {"mbot_interfaces/MotorVelocity", {"float32[3] velocity\n", {}}},
+      // apriltag_ros's detections (apriltag_msgs 2.0, as Jazzy ships it)
+      {"apriltag_msgs/Point", {"float64 x\nfloat64 y\n", {}}},
+      {"apriltag_msgs/AprilTagDetection",
+       {"string family\nint32 id\nint32 hamming\nfloat32 goodness\nfloat32 decision_margin\n"
+        "apriltag_msgs/Point centre\napriltag_msgs/Point[4] corners\nfloat64[9] homography\n",
+        {"apriltag_msgs/Point"}}},
+      {"apriltag_msgs/AprilTagDetectionArray",
+       {"std_msgs/Header header\napriltag_msgs/AprilTagDetection[] detections\n",
+        {"std_msgs/Header", "apriltag_msgs/AprilTagDetection"}}},
       {"sensor_msgs/CompressedImage", {"std_msgs/Header header\nstring format\nuint8[] data\n", {"std_msgs/Header"}}},
       {"visualization_msgs/UVCoordinate", {"float32 u\nfloat32 v\n", {}}},
       {"visualization_msgs/MeshFile", {"string filename\nuint8[] data\n", {}}},

@@ -61,8 +61,10 @@ std::string EventEncoder::TopicFor(const Event& ev) const {
     case EventKind::kParticles: return topics_.Wire(topics::kSlamParticles);
     case EventKind::kPath: return topics_.Wire(topics::kPath);
     case EventKind::kEncoders: return topics_.Wire(topics::kEncoders);
+    case EventKind::kWheelSpeed: return topics_.Wire(topics::kMotorVelocity);
     case EventKind::kFrontiers: return topics_.Wire(topics::kFrontiers);
     case EventKind::kMissionStatus: return topics_.Wire(topics::kMissionStatus);
+    case EventKind::kTagSightings: return topics_.Wire(topics::kTags);
     default: break;
   }
   std::string name = "/";  // else "/" and the channel's name in lower case (a valid ROS name)
@@ -238,6 +240,14 @@ bool EventEncoder::Encoders(const Event& ev, const msgs::EncoderTicks& e) {
   return true;
 }
 
+bool EventEncoder::Wheels(const Event& ev, const msgs::WheelSpeeds& w) {
+  if (ev.kind != EventKind::kWheelSpeed) return false;
+  ros2::MotorVelocity m;
+  m.velocity = {static_cast<float>(w.left_rad_s), static_cast<float>(w.right_rad_s), 0.0f};
+  Put(TopicFor(ev), kMotorVelocityType, ev.t_us, ros2::Encode(m));
+  return true;
+}
+
 bool EventEncoder::FrontierSet(const Event& ev, const msgs::Frontiers& f) {
   // One POINTS marker per region (a DELETEALL first, so regions that closed disappear in RViz).
   MarkerArray m;
@@ -277,6 +287,34 @@ std::optional<msgs::MissionStatus> ParseMissionState(const std::string& text) {
   s.state = *state;
   if (colon != std::string::npos) s.detail = text.substr(std::min(text.size(), colon + 2));
   return s;
+}
+
+bool EventEncoder::Tags(const Event& ev, const msgs::TagSightings& tags) {
+  // apriltag_ros's two outputs: the detections in the image, and each tag's pose on /tf (child
+  // frame "<family>:<id>", as apriltag_ros names it, in the camera's optical frame).
+  AprilTagDetectionArray m;
+  m.header = {StampOf(ev.t_us), frames_.camera};
+  TFMessage tf;
+  for (const msgs::TagSighting& t : tags.tags) {
+    AprilTagDetection d;
+    d.family = t.family;
+    d.id = t.id;
+    d.hamming = t.hamming;
+    d.decision_margin = static_cast<float>(t.margin);
+    d.centre = t.centre_px;
+    d.corners = t.corners_px;
+    d.homography = t.homography;
+    m.detections.push_back(std::move(d));
+    TransformStamped p;
+    p.header = m.header;
+    p.child_frame_id = (t.family.empty() ? std::string("tag") : t.family) + ":" + std::to_string(t.id);
+    p.transform.translation = {t.x_m, t.y_m, t.z_m};
+    p.transform.rotation = {t.qx, t.qy, t.qz, t.qw};
+    tf.transforms.push_back(std::move(p));
+  }
+  Put(TopicFor(ev), kAprilTagDetectionArrayType, ev.t_us, ros2::Encode(m));
+  if (!tf.transforms.empty()) Put("/tf", kTFMessageType, ev.t_us, ros2::Encode(tf));
+  return true;
 }
 
 }  // namespace mbot::ros2

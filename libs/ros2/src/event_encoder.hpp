@@ -19,6 +19,7 @@ namespace mbot::ros2 {
 struct Frames {
   std::string map = "map", odom = "odom", robot = "base_footprint";
   std::string lidar = "lidar_link", imu = "base_link";
+  std::string camera = "camera";  // the image's frame (camera_ros's default): tag detections and their /tf
 };
 
 struct EncodedMessage {
@@ -42,6 +43,7 @@ class EventEncoder : private msgs::EventVisitor {
   bool Lidar(const msgs::Event&, const msgs::LidarScan&) override;
   bool Pose(const msgs::Event&, const msgs::Pose2D&) override;
   bool Encoders(const msgs::Event&, const msgs::EncoderTicks&) override;
+  bool Wheels(const msgs::Event&, const msgs::WheelSpeeds&) override;
   bool ImuReading(const msgs::Event&, const msgs::Imu&) override;
   bool Motors(const msgs::Event&, const msgs::MotorCommand&) override;
   bool Map(const msgs::Event&, const msgs::OccupancyGrid&) override;
@@ -49,6 +51,7 @@ class EventEncoder : private msgs::EventVisitor {
   bool ParticleSet(const msgs::Event&, const msgs::Particles&) override;
   bool FrontierSet(const msgs::Event&, const msgs::Frontiers&) override;
   bool Mission(const msgs::Event&, const msgs::MissionStatus&) override;
+  bool Tags(const msgs::Event&, const msgs::TagSightings&) override;
   void Put(std::string topic, const char* type, int64_t t_us, std::vector<uint8_t> cdr);
 
   msgs::TopicTable topics_;

@@ -205,6 +205,7 @@ MessageDecoder::Type MessageDecoder::TypeOf(const std::string& type, const std::
                                                 {kPoseStampedType, Type::kPoseStamped},
                                                 {kPoseWithCovarianceStampedType, Type::kPoseWithCovariance},
                                                 {kEncodersType, Type::kEncoders},
+                                                {kMotorVelocityType, Type::kMotorVelocity},
                                                 {kOccupancyGridType, Type::kMap},
                                                 {kStringType, Type::kString}};
   if (type == kTFMessageType) return wire == "/tf_static" ? Type::kTfStatic : Type::kTf;
@@ -281,6 +282,15 @@ bool MessageDecoder::Decode(Type type, const std::string& topic, const std::stri
       ev->kind = EventKind::kEncoders;
       ev->stamp_us = StampUs(e.stamp) != 0 ? StampUs(e.stamp) : t_us;
       ev->payload = msgs::EncoderTicks{e.ticks[0], e.ticks[1], e.delta_ticks[0], e.delta_ticks[1], e.delta_time};
+      return true;
+    }
+    case Type::kMotorVelocity: {  // no stamp: the time it came
+      const MotorVelocity m = DecodeMotorVelocity(d, size, s);
+      if (!std::isfinite(m.velocity[0]) || !std::isfinite(m.velocity[1]))
+        throw std::runtime_error("non-finite velocity");
+      ev->kind = EventKind::kWheelSpeed;
+      ev->stamp_us = t_us;
+      ev->payload = msgs::WheelSpeeds{m.velocity[0], m.velocity[1]};
       return true;
     }
     case Type::kMap: {

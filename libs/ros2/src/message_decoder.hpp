@@ -1,8 +1,8 @@
 // The MBot generation's ROS 2 messages as the pipeline's events, for every ROS 2 input (bags, the
 // DDS transport): LaserScan → lidar (the mount from /tf_static), Odometry → odometry, Imu → imu,
 // Twist → velocity command, PoseStamped / PoseWithCovarianceStamped → the pose role of their
-// topic, Encoders → encoder ticks, OccupancyGrid → a map, String on the mission topic → the
-// mission's state; /tf_static builds the static tree (loops and second parents refused).
+// topic, Encoders → encoder ticks, MotorVelocity → wheel speeds, OccupancyGrid → a map, String on the mission topic →
+// the mission's state; /tf_static builds the static tree (loops and second parents refused).
 #pragma once
 
 #include <cstdint>
@@ -32,6 +32,7 @@ class MessageDecoder {
     kPoseStamped,
     kPoseWithCovariance,
     kEncoders,
+    kMotorVelocity,
     kMap,
     kString
   };

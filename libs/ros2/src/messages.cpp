@@ -163,6 +163,32 @@ Encoders DecodeEncoders(const uint8_t* data, size_t size, Serialization serializ
   return m;
 }
 
+MotorVelocity DecodeMotorVelocity(const uint8_t* data, size_t size, Serialization serialization) {
+  CdrReader r = Reader(data, size, serialization);
+  MotorVelocity m;
+  for (float& v : m.velocity) v = r.F32("velocity");
+  return m;
+}
+
+AprilTagDetectionArray DecodeAprilTagDetectionArray(const uint8_t* data, size_t size, Serialization serialization) {
+  CdrReader r = Reader(data, size, serialization);
+  AprilTagDetectionArray m;
+  m.header = ReadHeader(r);
+  // Each detection: a string (4 + 1 at least), four int32/float32 and 19 float64.
+  m.detections.resize(r.Count("detections", 4 + 1 + 16 + 19 * 8));
+  for (AprilTagDetection& d : m.detections) {
+    d.family = r.String("detections.family");
+    d.id = r.I32("detections.id");
+    d.hamming = r.I32("detections.hamming");
+    d.goodness = r.F32("detections.goodness");
+    d.decision_margin = r.F32("detections.decision_margin");
+    r.F64Array("detections.centre", d.centre.data(), d.centre.size());
+    r.F64Array("detections.corners", d.corners.data(), d.corners.size());
+    r.F64Array("detections.homography", d.homography.data(), d.homography.size());
+  }
+  return m;
+}
+
 std::vector<uint8_t> Encode(const LaserScan& m) {
   CdrWriter w;
   WriteHeader(w, m.header);
@@ -284,6 +310,12 @@ std::vector<uint8_t> Encode(const Encoders& m) {
   return w.bytes();
 }
 
+std::vector<uint8_t> Encode(const MotorVelocity& m) {
+  CdrWriter w;
+  for (float v : m.velocity) w.F32(v);
+  return w.bytes();
+}
+
 std::vector<uint8_t> Encode(const MarkerArray& m) {
   CdrWriter w;
   w.U32(static_cast<uint32_t>(m.markers.size()));
@@ -310,6 +342,21 @@ std::vector<uint8_t> Encode(const MarkerArray& m) {
     w.String("");            // mesh_resource
     w.String(""), w.U32(0);  // mesh_file: filename, data
     w.Bool(k.mesh_use_embedded_materials);
+  }
+  return w.bytes();
+}
+
+std::vector<uint8_t> Encode(const AprilTagDetectionArray& m) {
+  CdrWriter w;
+  WriteHeader(w, m.header);
+  w.U32(static_cast<uint32_t>(m.detections.size()));
+  for (const AprilTagDetection& d : m.detections) {
+    w.String(d.family);
+    w.I32(d.id), w.I32(d.hamming);
+    w.F32(d.goodness), w.F32(d.decision_margin);
+    w.F64Array(d.centre.data(), d.centre.size());
+    w.F64Array(d.corners.data(), d.corners.size());
+    w.F64Array(d.homography.data(), d.homography.size());
   }
   return w.bytes();
 }

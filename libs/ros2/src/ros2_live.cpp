@@ -76,6 +76,7 @@ Ros2NodeOptions ParseRos2NodeOptions(config::Section& s, const std::string& url)
   o.frames.robot = s.GetString("base_frame", o.frames.robot, "ros2: the robot's frame (odometry's child)");
   o.frames.lidar = s.GetString("lidar_frame", o.frames.lidar, "ros2: the scans' frame (what a simulated robot says)");
   o.frames.imu = s.GetString("imu_frame", o.frames.imu, "ros2: the IMU's frame");
+  o.frames.camera = s.GetString("camera_frame", o.frames.camera, "ros2: the camera image's frame (tag detections)");
   return o;
 }
 

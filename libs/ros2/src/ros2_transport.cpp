@@ -27,6 +27,7 @@ msgs::TopicTable DefaultTopics() {
                            {topics::kPath, "/planned_path"},
                            {topics::kFrontiers, "/frontier_markers"},
                            {topics::kMissionStatus, "/mission_state"},
+                           {topics::kTags, "/detections"},
                            {topics::kTruePose, "/ground_truth"}});
 }
 

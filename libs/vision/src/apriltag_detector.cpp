@@ -13,8 +13,12 @@ extern "C" {
 #include <tag25h9.h>
 #include <tag36h11.h>
 #include <tagCircle21h7.h>
+#include <tagCircle49h12.h>
+#include <tagCustom48h12.h>
 #include <tagStandard41h12.h>
+#include <tagStandard52h13.h>
 #include <common/image_u8.h>
+#include <common/matd.h>
 }
 
 namespace mbot::vision {
@@ -31,7 +35,13 @@ const Family kFamilies[] = {{"tag36h11", tag36h11_create, tag36h11_destroy},
                             {"tag25h9", tag25h9_create, tag25h9_destroy},
                             {"tag16h5", tag16h5_create, tag16h5_destroy},
                             {"tagStandard41h12", tagStandard41h12_create, tagStandard41h12_destroy},
-                            {"tagCircle21h7", tagCircle21h7_create, tagCircle21h7_destroy}};
+                            {"tagStandard52h13", tagStandard52h13_create, tagStandard52h13_destroy},
+                            {"tagCircle21h7", tagCircle21h7_create, tagCircle21h7_destroy},
+                            {"tagCircle49h12", tagCircle49h12_create, tagCircle49h12_destroy},
+                            // the ROS 2 MBot's tags (5.4 cm, through apriltag_ros)
+                            {"tagCustom48h12", tagCustom48h12_create, tagCustom48h12_destroy}};
+
+constexpr uint32_t kLargeFamilyCodes = 10000;
 
 const Family& FindFamily(const std::string& name) {
   std::string known;
@@ -43,6 +53,12 @@ const Family& FindFamily(const std::string& name) {
 }
 
 }  // namespace
+
+std::vector<std::string> TagFamilies() {
+  std::vector<std::string> names;
+  for (const Family& f : kFamilies) names.emplace_back(f.name);
+  return names;
+}
 
 cv::Mat TagImage(const std::string& family, int id, int pixels_per_cell) {
   const Family& f = FindFamily(family);
@@ -66,6 +82,10 @@ struct TagDetector::Impl {
   apriltag_family_t* family = nullptr;
   void (*destroy_family)(apriltag_family_t*) = nullptr;
   apriltag_detector_t* detector = nullptr;
+  ~Impl() {  // also when the constructor throws
+    if (detector) apriltag_detector_destroy(detector);
+    if (family) destroy_family(family);
+  }
 };
 
 TagDetector::TagDetector(const TagDetectorOptions& o) : options_(o), impl_(std::make_unique<Impl>()) {
@@ -74,10 +94,17 @@ TagDetector::TagDetector(const TagDetectorOptions& o) : options_(o), impl_(std::
   impl_->destroy_family = f.destroy;
   if (!(o.decimate >= 1.0)) throw std::invalid_argument("tag detector: decimate must be >= 1");
   if (o.threads < 1) throw std::invalid_argument("tag detector: threads must be >= 1");
-  if (o.max_bits_corrected < 0 || o.max_bits_corrected > 3)
-    throw std::invalid_argument("tag detector: max_bits_corrected must be 0..3");
+  if (o.max_bits_corrected < -1 || o.max_bits_corrected > 3)
+    throw std::invalid_argument("tag detector: max_bits_corrected must be 0..3 (or -1: the family's default)");
+  const bool large = impl_->family->ncodes > kLargeFamilyCodes;
+  if (large && o.max_bits_corrected > 1) {
+    throw std::invalid_argument("tag detector: " + o.family + " has " + std::to_string(impl_->family->ncodes) +
+                                " codes; correcting " + std::to_string(o.max_bits_corrected) +
+                                " bits needs a table of gigabytes: max_bits_corrected must be 0 or 1");
+  }
+  const int bits = o.max_bits_corrected >= 0 ? o.max_bits_corrected : large ? 1 : 2;
   impl_->detector = apriltag_detector_create();
-  apriltag_detector_add_family_bits(impl_->detector, impl_->family, o.max_bits_corrected);
+  apriltag_detector_add_family_bits(impl_->detector, impl_->family, bits);
   impl_->detector->quad_decimate = static_cast<float>(o.decimate);
   impl_->detector->quad_sigma = static_cast<float>(o.blur_sigma);
   impl_->detector->refine_edges = o.refine_edges;
@@ -85,10 +112,7 @@ TagDetector::TagDetector(const TagDetectorOptions& o) : options_(o), impl_(std::
   impl_->detector->nthreads = o.threads;
 }
 
-TagDetector::~TagDetector() {
-  if (impl_->detector) apriltag_detector_destroy(impl_->detector);
-  if (impl_->family) impl_->destroy_family(impl_->family);
-}
+TagDetector::~TagDetector() = default;
 
 std::vector<TagDetection> TagDetector::Detect(const cv::Mat& image) const {
   if (image.empty() || image.depth() != CV_8U) throw std::invalid_argument("tag detector: needs an 8-bit image");
@@ -110,6 +134,7 @@ std::vector<TagDetection> TagDetector::Detect(const cv::Mat& image) const {
     t.margin = d->decision_margin;
     for (int k = 0; k < 4; ++k) t.corners[k] = {d->p[k][0], d->p[k][1]};
     t.center = {d->c[0], d->c[1]};
+    for (int k = 0; k < 9; ++k) t.homography[k] = MATD_EL(d->H, k / 3, k % 3);
     out.push_back(t);
   }
   apriltag_detections_destroy(found);

@@ -9,10 +9,10 @@ namespace mbot::vision {
 
 TagDetectorOptions ParseTagDetectorOptions(config::Section& s, const TagDetectorOptions& d) {
   TagDetectorOptions o = d;
-  o.family = s.GetChoice("family", d.family, {"tag36h11", "tag25h9", "tag16h5", "tagStandard41h12", "tagCircle21h7"},
-                         "tag family");
-  o.max_bits_corrected =
-      static_cast<int>(s.GetInt("max_bits_corrected", d.max_bits_corrected, "bit errors the decoder corrects", 0, 3));
+  o.family = s.GetChoice("family", d.family, TagFamilies(), "tag family");
+  o.max_bits_corrected = static_cast<int>(
+      s.GetInt("max_bits_corrected", d.max_bits_corrected,
+               "bit errors the decoder corrects (-1: 2, or 1 for a family of over 10,000 codes)", -1, 3));
   o.decimate = s.GetDouble("decimate", d.decimate, "find quads on an image this much smaller", 1.0, 16.0);
   o.blur_sigma = s.GetDouble("blur_sigma", d.blur_sigma, "Gaussian blur before quads (0: none) [px]", 0.0, 10.0);
   o.refine_edges = s.GetBool("refine_edges", d.refine_edges, "snap quad edges to strong gradients");

@@ -23,8 +23,11 @@ void AddVisionTypes(TypeTable& t) {
               return false;
             }
             // The botlab's publisher: millimetres; quaternion x, y, z, w.
-            out.tags.push_back(
-                {t.tag_id, p.x * 1e-3, p.y * 1e-3, p.z * 1e-3, q[3] / norm, q[0] / norm, q[1] / norm, q[2] / norm});
+            TagSighting seen;  // a pose only: this message has no image coordinates
+            seen.id = t.tag_id;
+            seen.x_m = p.x * 1e-3, seen.y_m = p.y * 1e-3, seen.z_m = p.z * 1e-3;
+            seen.qw = q[3] / norm, seen.qx = q[0] / norm, seen.qy = q[1] / norm, seen.qz = q[2] / norm;
+            out.tags.push_back(std::move(seen));
           }
           ev->kind = EventKind::kTagSightings;
           ev->stamp_us = m.utime;

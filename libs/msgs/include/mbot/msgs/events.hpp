@@ -4,6 +4,7 @@
 // beyond mbot_common.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -108,9 +109,20 @@ struct Particles {
 // quaternion). On the wire (MBOT_APRILTAG_ARRAY, mbot_apriltag_array_t) it travels the way the
 // botlab's publisher sends it: millimetres, roll-pitch-yaw in degrees, the quaternion as x, y, z, w.
 struct TagSighting {
+  TagSighting() = default;
+  TagSighting(int id_, double x, double y, double z, double w, double qx_, double qy_, double qz_)
+      : id(id_), x_m(x), y_m(y), z_m(z), qw(w), qx(qx_), qy(qy_), qz(qz_) {}  // a pose only
   int id = 0;
   double x_m = 0.0, y_m = 0.0, z_m = 0.0;
   double qw = 1.0, qx = 0.0, qy = 0.0, qz = 0.0;
+  // Where it was in the image, when a detector here saw it (a bus that carries poses only, as
+  // mbot_apriltag_array_t does, leaves `family` empty and the rest zero).
+  std::string family;  // the library's name ("tagCustom48h12")
+  int hamming = 0;
+  double margin = 0.0;                 // decision margin
+  std::array<double, 2> centre_px{};   // x, y
+  std::array<double, 8> corners_px{};  // x0, y0 … x3, y3 in the library's order
+  std::array<double, 9> homography{};  // tag (-1..1) → image, row-major
 };
 
 // Every tag seen in one camera frame (an empty list is a frame with none).

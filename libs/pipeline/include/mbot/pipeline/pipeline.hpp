@@ -63,11 +63,13 @@ struct RunSummary {
 // `stop` becomes true; then every stage's Finish writes its outputs.
 RunSummary RunPlan(PipelinePlan& plan, const std::atomic<bool>& stop);
 
-// True when the plan's source is a robot's bus (lcm_live, lcm_relay, ros2_live): its work comes in
+// True when the configuration's source is a robot's bus (lcm_live, lcm_relay, ros2_live): its work comes in
 // bursts (a scan every 100 ms), so OpenMP's worker threads should sleep between them rather than
 // spin — libgomp's default spin after each parallel region cost the live autonomy ~7 % of a core
 // (BENCHMARKS.md, "Live path"). The wait policy is read once at load, from OMP_WAIT_POLICY; the
-// app re-executes itself with OMP_WAIT_POLICY=PASSIVE when this is true and it is unset.
-bool SourceIsABus(const PipelinePlan& plan);
+// app re-executes itself with OMP_WAIT_POLICY=PASSIVE when this is true and it is unset. It reads
+// the configuration's [source] type only, so the app can decide before building the plan (which
+// opens the bus and sizes the maps: building it twice cost ~0.4 CPU-s at every live start).
+bool SourceIsABus(const config::Config& config);
 
 }  // namespace mbot::pipeline

@@ -109,6 +109,9 @@ struct Encoders {  // mbot_interfaces/Encoders (the MBot's firmware): [0] left, 
   std::array<int32_t, 3> delta_ticks{};
   int32_t delta_time = 0;  // [µs]
 };
+struct MotorVelocity {  // mbot_interfaces/MotorVelocity (the MBot's firmware): [0] left, [1] right [rad/s]
+  std::array<float, 3> velocity{};
+};
 struct ColorRGBA {  // std_msgs/ColorRGBA
   float r = 0, g = 0, b = 0, a = 0;
 };
@@ -131,6 +134,19 @@ struct MarkerArray {  // visualization_msgs/MarkerArray
   std::vector<Marker> markers;
 };
 
+struct AprilTagDetection {  // apriltag_msgs/AprilTagDetection (apriltag_ros: what the MBot's camera publishes)
+  std::string family;
+  int32_t id = 0, hamming = 0;
+  float goodness = 0, decision_margin = 0;
+  std::array<double, 2> centre{};      // apriltag_msgs/Point centre: x, y [px]
+  std::array<double, 8> corners{};     // apriltag_msgs/Point[4] corners
+  std::array<double, 9> homography{};  // row-major
+};
+struct AprilTagDetectionArray {  // apriltag_msgs/AprilTagDetectionArray
+  Header header;
+  std::vector<AprilTagDetection> detections;
+};
+
 // The ROS 2 type names ("sensor_msgs/msg/LaserScan"), as rosbag2 and the DDS layer name them.
 inline constexpr const char* kLaserScanType = "sensor_msgs/msg/LaserScan";
 inline constexpr const char* kOdometryType = "nav_msgs/msg/Odometry";
@@ -144,7 +160,9 @@ inline constexpr const char* kPathType = "nav_msgs/msg/Path";
 inline constexpr const char* kOccupancyGridType = "nav_msgs/msg/OccupancyGrid";
 inline constexpr const char* kStringType = "std_msgs/msg/String";
 inline constexpr const char* kEncodersType = "mbot_interfaces/msg/Encoders";
+inline constexpr const char* kMotorVelocityType = "mbot_interfaces/msg/MotorVelocity";
 inline constexpr const char* kMarkerArrayType = "visualization_msgs/msg/MarkerArray";
+inline constexpr const char* kAprilTagDetectionArrayType = "apriltag_msgs/msg/AprilTagDetectionArray";
 
 // How a payload is serialized: ROS 2's CDR, or ROS 1's (a ROS 1 bag: packed, Header with seq).
 enum class Serialization { kCdr, kRos1 };
@@ -160,6 +178,9 @@ PoseWithCovarianceStamped DecodePoseWithCovarianceStamped(const uint8_t* data, s
 OccupancyGrid DecodeOccupancyGrid(const uint8_t* data, size_t size, Serialization s = Serialization::kCdr);
 String DecodeString(const uint8_t* data, size_t size, Serialization s = Serialization::kCdr);
 Encoders DecodeEncoders(const uint8_t* data, size_t size, Serialization s = Serialization::kCdr);
+MotorVelocity DecodeMotorVelocity(const uint8_t* data, size_t size, Serialization s = Serialization::kCdr);
+AprilTagDetectionArray DecodeAprilTagDetectionArray(const uint8_t* data, size_t size,
+                                                    Serialization s = Serialization::kCdr);
 
 std::vector<uint8_t> Encode(const LaserScan& m);
 std::vector<uint8_t> Encode(const Odometry& m);
@@ -173,7 +194,9 @@ std::vector<uint8_t> Encode(const Path& m);
 std::vector<uint8_t> Encode(const OccupancyGrid& m);
 std::vector<uint8_t> Encode(const String& m);
 std::vector<uint8_t> Encode(const Encoders& m);
+std::vector<uint8_t> Encode(const MotorVelocity& m);
 std::vector<uint8_t> Encode(const MarkerArray& m);
+std::vector<uint8_t> Encode(const AprilTagDetectionArray& m);
 
 // A planar yaw from a quaternion, and back (the MBot's frames differ by yaw only).
 double Yaw(const Quaternion& q);

@@ -14,11 +14,14 @@
 namespace mbot::vision {
 
 struct TagDetectorOptions {
-  std::string family = "tag36h11";  // tag36h11, tag25h9, tag16h5, tagStandard41h12, tagCircle21h7
-  int max_bits_corrected = 2;       // the library's default for add_family
-  double decimate = 2.0;            // quad_decimate: detect quads on an image this much smaller
-  double blur_sigma = 0.0;          // quad_sigma: Gaussian blur before quads (0: none)
-  bool refine_edges = true;         // snap the quad's edges to strong gradients
+  std::string family = "tag36h11";  // one of TagFamilies(); the ROS 2 MBot's are tagCustom48h12
+  // Bit errors the decoder corrects; -1: the library's default for add_family (2), or 1 for a family
+  // of more than 10,000 codes (tagCustom48h12, tagStandard52h13, tagCircle49h12), whose 2-bit table
+  // takes seconds and gigabytes to build (7.5 s for tagCustom48h12, here); 2 or 3 there is refused.
+  int max_bits_corrected = -1;
+  double decimate = 2.0;     // quad_decimate: detect quads on an image this much smaller
+  double blur_sigma = 0.0;   // quad_sigma: Gaussian blur before quads (0: none)
+  bool refine_edges = true;  // snap the quad's edges to strong gradients
   double decode_sharpening = 0.25;
   int threads = 1;
 };
@@ -29,7 +32,11 @@ struct TagDetection {
   double margin = 0.0;                 // decision margin (higher: surer)
   std::array<cv::Point2d, 4> corners;  // the library's order (counter-clockwise in the image)
   cv::Point2d center;
+  std::array<double, 9> homography{};  // tag frame (-1..1) → image, row-major, as the library gives it
 };
+
+// The families the detector knows: every family of Debian's libapriltag 3.3.
+std::vector<std::string> TagFamilies();
 
 // The tag as the library draws it (its total_width cells, white border included), each cell
 // `pixels_per_cell` pixels: for printing, and for the simulator's crates. Throws
