@@ -8,6 +8,8 @@
 # autonomy's CPU seconds (user + system, /usr/bin/time) per wall second, and the robot's loop
 # latency (a scan published → the first /cmd_vel received after it: median and p99 of each run).
 #   scripts/bench_live.sh [seconds] [runs] [build dir]      (default 60 s, 3 runs, build)
+# CASES="lcm ros2_1t …" picks cases; <transport>_1t runs the autonomy on one OpenMP thread
+# (OMP_NUM_THREADS=1, no re-exec).
 set -eu
 seconds=${1:-60}
 runs=${2:-3}
@@ -17,7 +19,7 @@ bin=$root/$build/apps/mbot_nav/mbot_nav
 out=$(mktemp -d /tmp/bench_live.XXXX)
 export bin root seconds
 for run in $(seq 1 "$runs"); do
-  for case in lcm ros2 lcm_spin ros2_spin; do
+  for case in ${CASES:-lcm ros2 lcm_spin ros2_spin}; do
     dir=$out/$case/$run
     mkdir -p "$dir"
     export case dir
@@ -25,7 +27,7 @@ for run in $(seq 1 "$runs"); do
       set -eu
       ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo
       case $case in lcm*) a=live.ini r=sim_robot.ini ;; *) a=ros2_live.ini r=sim_robot_ros2.ini ;; esac
-      case $case in *_spin) export OMP_WAIT_POLICY= ;; *) unset OMP_WAIT_POLICY ;; esac
+      case $case in *_spin) export OMP_WAIT_POLICY= ;; *_1t) export OMP_WAIT_POLICY= OMP_NUM_THREADS=1 ;; *) unset OMP_WAIT_POLICY ;; esac
       /usr/bin/time -f "%U %S %e" -o "$dir/time" "$bin" --config "$root/config/$a" \
         --set output.dir="$dir/autonomy" --set source.duration_s=$seconds --set pipeline.progress=off \
         > "$dir/autonomy.log" 2>&1 &
@@ -37,12 +39,12 @@ for run in $(seq 1 "$runs"); do
     ' 2> /dev/null || { echo "bench_live: run $run of $case failed (logs in $dir)"; exit 1; }
   done
 done
-python3 - "$out" "$runs" <<'PY'
+python3 - "$out" "$runs" "${CASES:-lcm ros2 lcm_spin ros2_spin}" <<'PY'
 import json, statistics, sys
 from pathlib import Path
 out, runs = Path(sys.argv[1]), int(sys.argv[2])
 print(f"{'case':<10} {'CPU s/run':>10} {'% of a core':>12} {'latency p50':>12} {'latency p99':>12}   (medians of {runs} runs)")
-for case in ("lcm", "ros2", "lcm_spin", "ros2_spin"):
+for case in sys.argv[3].split():
     cpu, share, p50, p99 = [], [], [], []
     for run in range(1, runs + 1):
         d = out / case / str(run)

@@ -37,6 +37,8 @@ and runs nothing (config/sweep_mazes.ini); config/merge_sweep.ini merges the job
 options:
   --config FILE          the INI file (include = other.ini pulls in shared defaults)
   --set S.K=V            override key K of section S (repeatable; applied after includes)
+  --unset S.K            remove key K of section S that FILE or its includes set (repeatable;
+                         e.g. source.carmen_order when graph_slam.ini replays a bag)
   --print-config         print the effective configuration and exit
   --list-stages          list the stage types with their keys and defaults and exit
   --list-sources         list the source types ([source] type) and what each reads, and exit
@@ -102,7 +104,7 @@ void ListSources() {
 int main(int argc, char** argv) {
   mbot::app::RegisterAll();
   std::string config_path;
-  std::vector<std::string> sets;
+  std::vector<std::string> sets, unsets;
   bool print_config = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -125,6 +127,8 @@ int main(int argc, char** argv) {
       sets.push_back(value("--set"));
     } else if (a.rfind("--set=", 0) == 0) {
       sets.push_back(a.substr(6));
+    } else if (a == "--unset") {
+      unsets.push_back(value("--unset"));
     } else if (a == "--print-config") {
       print_config = true;
     } else if (a == "--list-stages") {
@@ -152,6 +156,7 @@ int main(int argc, char** argv) {
   std::optional<mbot::app::CompetitionPlan> competition;
   try {
     auto config = mbot::config::Config::Load(config_path);
+    for (const auto& u : unsets) config.Unset(u);
     for (const auto& s : sets) config.Set(s);
     if (print_config) {
       std::cout << config.ToIni();

@@ -5,7 +5,10 @@
 # through config/sim_robot_ros2.ini; `warehouse`: config/ros2_live_warehouse.ini makes one delivery
 # through config/sim_robot_ros2_warehouse.ini. Asserts the robot's referee saw the mission complete
 # with no collision (explore: coverage ≥ 99 %), the autonomy's mission completed and it rejected
-# nothing. Exits 77 (skipped) where namespaces are not permitted.
+# nothing. `explore` runs with the viewer on (viewer.enabled beside ros2_live.ini): while the robot
+# explores, Foxglove's protocol client subscribes to every channel and validates each message
+# against Foxglove's schemas, and headless Chromium opens the page and must see the map, the robot
+# and the lidar drawn. Exits 77 (skipped) where namespaces are not permitted.
 #   over_ros2.sh <mbot_nav> <config dir> <output dir> explore|warehouse [seed]
 set -u
 bin=$1 config=$2 out=$3 task=$4 seed=${5:-2}
@@ -14,14 +17,18 @@ if ! unshare -n true 2>/dev/null; then
   exit 77
 fi
 command -v ip > /dev/null || { echo "SKIPPED: ip is not installed; scripts/install_deps.sh installs it"; exit 77; }
+viewer_dir=$(cd "$(dirname "$0")/../viewer" && pwd)
 case $task in
-  explore) autonomy_ini=ros2_live.ini robot_ini=sim_robot_ros2.ini extra="" limit=150 ;;
+  explore) autonomy_ini=ros2_live.ini robot_ini=sim_robot_ros2.ini limit=150
+    extra="--set viewer.enabled=true --set viewer.port=0 --set viewer.http_port=0"
+    command -v node > /dev/null && [ -d "$viewer_dir/node_modules/@foxglove/ws-protocol" ] ||
+      { echo "FAIL: node or $viewer_dir/node_modules is missing: run scripts/install_deps.sh"; exit 1; } ;;
   warehouse) autonomy_ini=ros2_live_warehouse.ini robot_ini=sim_robot_ros2_warehouse.ini
     extra="--set mission.deliveries=1" limit=200 ;;
   *) echo "over_ros2.sh: task is explore or warehouse, not '$task'"; exit 2 ;;
 esac
 rm -rf "$out" && mkdir -p "$out"
-export bin config out seed autonomy_ini robot_ini extra limit
+export bin config out seed autonomy_ini robot_ini extra limit task viewer_dir
 unshare -n bash -c '
   set -u
   ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo ||
@@ -33,16 +40,32 @@ unshare -n bash -c '
   # Time limits below ctest'"'"'s 300 s, so a stalled run fails with its logs instead of timing out.
   "$bin" --config "$config/$robot_ini" --set output.dir="$out/robot" --set pipeline.progress=off \
     --set pipeline.seed=$seed --set referee.time_limit_s=$limit --set source.duration_s=$((limit + 30)) \
-    > "$out/robot.log" 2>&1
+    > "$out/robot.log" 2>&1 &
+  robot=$!
+  viewer_rc=0
+  if [ "$task" = explore ]; then
+    for _ in $(seq 50); do grep -q "^viewer: Foxglove at" "$out/autonomy.log" && break; sleep 0.1; done
+    line=$(grep -m1 "^viewer: Foxglove at" "$out/autonomy.log")
+    ws_url=$(echo "$line" | sed -n "s/.*Foxglove at \(ws:[^ ,]*\).*/\1/p")
+    page_url=$(echo "$line" | sed -n "s/.*the page at \(http:[^ ,]*\).*/\1/p")
+    echo "$line"
+    sleep 8  # the robot is mapping
+    (cd "$viewer_dir" && node foxglove_client.mjs "$ws_url" 4 "$out/foxglove_client.json" /map /scan /tf /pose \
+      /odom /scene /mission) > "$out/viewer_clients.log" 2>&1 || viewer_rc=1
+    (cd "$viewer_dir" && node browser.mjs "$page_url" "$out/page.png" "$out/browser.json" live) >> "$out/viewer_clients.log" 2>&1 ||
+      viewer_rc=1
+  fi
+  wait $robot
   robot_rc=$?
   wait $autonomy
   autonomy_rc=$?
-  echo "robot exit $robot_rc, autonomy exit $autonomy_rc"
-  exit $(( robot_rc != 0 || autonomy_rc != 0 ))
+  echo "robot exit $robot_rc, autonomy exit $autonomy_rc, viewer clients exit $viewer_rc"
+  exit $(( robot_rc != 0 || autonomy_rc != 0 || viewer_rc != 0 ))
 '
 rc=$?
 echo "--- robot (simulator + referee)"; tail -12 "$out/robot.log"
-echo "--- autonomy"; grep -E "ros2|mission: (lifting|setting_down|completed|failed)|error" "$out/autonomy.log" | tail -8
+echo "--- autonomy"; grep -E "ros2|viewer|mission: (lifting|setting_down|completed|failed)|error" "$out/autonomy.log" | tail -10
+[ -f "$out/viewer_clients.log" ] && { echo "--- Foxglove's client and Chromium"; tail -15 "$out/viewer_clients.log"; }
 [ $rc -eq 0 ] || { echo "FAIL: a process failed"; exit 1; }
 score="$out/robot/score.json"
 [ -f "$score" ] || { echo "FAIL: no score.json from the robot's referee"; exit 1; }

@@ -17,8 +17,8 @@
 
 namespace mbot::app {
 
-// Runs config/<config_name> with `sets` (section.key=value) into TempDir()/<out_name>; returns the
-// text of <report> in that folder ("" when it was not written).
+// Runs config/<config_name> with `sets` (section.key=value, or "--unset section.key") into TempDir()/<out_name>;
+// returns the text of <report> in that folder ("" when it was not written).
 inline std::string RunConfig(const std::string& config_name, const std::string& out_name,
                              const std::vector<std::string>& sets, const std::string& report) {
   auto c = config::Config::Load(std::string(MBOT_SOURCE_DIR) + "/config/" + config_name);
@@ -26,7 +26,7 @@ inline std::string RunConfig(const std::string& config_name, const std::string& 
   std::filesystem::remove_all(out);
   c.Set("output.dir=" + out);
   c.Set("pipeline.progress=off");
-  for (const auto& s : sets) c.Set(s);
+  for (const auto& s : sets) s.rfind("--unset ", 0) == 0 ? c.Unset(s.substr(8)) : c.Set(s);
   auto plan = pipeline::BuildPlan(c);
   std::atomic<bool> stop{false};
   pipeline::RunPlan(plan, stop);

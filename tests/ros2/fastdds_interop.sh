@@ -3,7 +3,8 @@
 # by Fast DDS (tests/ros2/fastdds_peer: fastddsgen's types from IDL written from the public .msg
 # files), inside a private network namespace (loopback up, multicast on it) so no packet leaves the
 # test. The peer publishes /tf_static, /odom and /scan for 8 s and asserts that a non-zero /cmd_vel
-# comes back and that a late-joining reader gets /map with the room where the mount puts it.
+# comes back, that a late-joining reader gets /map with the room where the mount puts it, and that
+# the autonomy announced its node /mbot_nav on ros_discovery_info with /cmd_vel's writer in it.
 #   fastdds_interop.sh <mbot_nav> <mbot_fastdds_peer> <config dir> <output dir>
 set -u
 bin=$1 peer=$2 config=$3 out=$4

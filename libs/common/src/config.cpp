@@ -150,6 +150,16 @@ void Config::Set(const std::string& assignment) {
   section_origins_.emplace(section, Origin{"--set", 0});
 }
 
+void Config::Unset(const std::string& name) {
+  const auto dot = name.find('.');
+  const std::string section = dot == std::string::npos ? "" : Trim(name.substr(0, dot));
+  const std::string key = dot == std::string::npos ? "" : Trim(name.substr(dot + 1));
+  auto it = sections_.find(section);
+  if (dot == std::string::npos || it == sections_.end() || it->second.erase(key) == 0) {
+    throw ConfigError("--unset " + name + ": no such key in the configuration (expected section.key)");
+  }
+}
+
 std::vector<std::string> Config::SectionNames() const {
   std::vector<std::string> names;
   for (const auto& [name, entries] : sections_) names.push_back(name);

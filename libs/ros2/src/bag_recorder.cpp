@@ -46,9 +46,12 @@ Qos DefaultQos(const std::string& topic) {
 }
 
 BagRecorder::BagRecorder(BagRecorderOptions options)
-    : o_(std::move(options)),
-      encoder_(o_.topics,
-               {o_.map_frame, o_.odom_frame, o_.robot_frame, o_.lidar_frame, o_.imu_frame, o_.camera_frame}) {}
+    : o_(std::move(options)), encoder_(o_.topics, [this] {
+        Frames f = o_.tree;
+        f.map = o_.map_frame, f.odom = o_.odom_frame, f.robot = o_.robot_frame;
+        f.lidar = o_.lidar_frame, f.imu = o_.imu_frame, f.camera = o_.camera_frame;
+        return f;
+      }()) {}
 BagRecorder::~BagRecorder() = default;
 
 void BagRecorder::Open(const msgs::RunContext& ctx) {
@@ -163,6 +166,7 @@ BagRecorderOptions ParseBagRecorderOptions(config::Section& s) {
   o.lidar_frame = s.GetString("lidar_frame", o.lidar_frame, "rosbag2: the scans' frame");
   o.imu_frame = s.GetString("imu_frame", o.imu_frame, "rosbag2: the IMU's frame");
   o.camera_frame = s.GetString("camera_frame", o.camera_frame, "rosbag2: the camera image's frame (tag detections)");
+  ParseTreeFrames(s, "rosbag2", &o.tree);
   return o;
 }
 

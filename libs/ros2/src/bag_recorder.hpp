@@ -29,6 +29,7 @@ struct BagRecorderOptions {
   msgs::TopicTable topics = DefaultTopics();
   std::string map_frame = "map", odom_frame = "odom", robot_frame = "base_footprint";
   std::string lidar_frame = "lidar_link", imu_frame = "base_link", camera_frame = "camera";
+  Frames tree;  // base_link and the heights of the /tf_static tree (the other frames above)
 };
 BagRecorderOptions ParseBagRecorderOptions(config::Section& section);
 

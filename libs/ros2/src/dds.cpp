@@ -14,6 +14,8 @@
 #include <map>
 #include <stdexcept>
 
+#include "mbot/ros2/cdr.hpp"
+
 namespace mbot::ros2 {
 
 std::string DdsTopicName(const std::string& ros_topic) {
@@ -179,8 +181,36 @@ struct DdsParticipant::Impl {
   std::atomic<long long> too_large{0};
   size_t max_bytes = 0;
 
-  dds_entity_t Topic(const std::string& topic, const std::string& type) {
-    const std::string name = DdsTopicName(topic);
+  dds_entity_t discovery = 0;  // the ros_discovery_info writer
+  std::string node_name;
+  long long announcements = 0;
+
+  // rmw_dds_common/msg/ParticipantEntitiesInfo (Jazzy: a Gid is char[16], the entity's DDS GUID):
+  // this participant, one node, the GIDs of its readers and writers.
+  void Announce() {
+    if (discovery <= 0) return;
+    CdrWriter w;
+    auto gid = [&](dds_entity_t e) {
+      dds_guid_t g{};
+      dds_get_guid(e, &g);
+      for (uint8_t b : g.v) w.U8(b);
+    };
+    gid(participant);
+    w.U32(1);
+    w.String("/");
+    w.String(node_name);
+    w.U32(static_cast<uint32_t>(readers.size()));
+    for (dds_entity_t r : readers) gid(r);
+    w.U32(static_cast<uint32_t>(writers.size()) + 1);  // its own writer too, as rmw_cyclonedds lists it
+    for (dds_entity_t x : writers) gid(x);
+    gid(discovery);
+    const std::vector<uint8_t>& bytes = w.bytes();
+    const Blob blob{bytes.data(), bytes.size()};
+    if (dds_write(discovery, &blob) == DDS_RETCODE_OK) ++announcements;
+  }
+
+  dds_entity_t Topic(const std::string& topic, const std::string& type, bool ros_name = true) {
+    const std::string name = ros_name ? DdsTopicName(topic) : topic;
     if (auto it = topics.find(name); it != topics.end()) return it->second;
     auto* t = new RawType;
     ddsi_sertype_init_flags(t, DdsTypeName(type).c_str(), &SertypeOps(), &SerdataOps(),
@@ -219,6 +249,19 @@ DdsParticipant::DdsParticipant(const DdsOptions& options) : impl_(std::make_uniq
     throw std::runtime_error("dds: cannot join domain " + std::to_string(options.domain_id) + ": " +
                              dds_strretcode(impl_->participant));
   impl_->waitset = dds_create_waitset(impl_->participant);
+  if (!options.node_name.empty()) {
+    // As rmw_cyclonedds: reliable, transient local, keep last 1, not under rt/.
+    impl_->node_name = options.node_name;
+    dds_qos_t* dq = QosOf({1, true, true});
+    impl_->discovery = dds_create_writer(
+        impl_->participant,
+        impl_->Topic("ros_discovery_info", "rmw_dds_common/msg/ParticipantEntitiesInfo", /*ros_name=*/false), dq,
+        nullptr);
+    dds_delete_qos(dq);
+    if (impl_->discovery < 0)
+      throw std::runtime_error("dds: ros_discovery_info: " + std::string(dds_strretcode(impl_->discovery)));
+    impl_->Announce();
+  }
 }
 
 DdsParticipant::~DdsParticipant() {
@@ -236,6 +279,7 @@ int DdsParticipant::AddReader(const std::string& topic, const std::string& type,
   dds_waitset_attach(impl_->waitset, cond, static_cast<dds_attach_t>(impl_->readers.size()));
   impl_->readers.push_back(r);
   impl_->reader_topics.push_back(topic);
+  impl_->Announce();
   return static_cast<int>(impl_->readers.size()) - 1;
 }
 
@@ -247,6 +291,7 @@ int DdsParticipant::AddWriter(const std::string& topic, const std::string& type,
   if (w < 0) throw std::runtime_error("dds: writer on " + topic + ": " + dds_strretcode(w));
   impl_->writers.push_back(w);
   impl_->writer_topics.push_back(topic);
+  impl_->Announce();
   return static_cast<int>(impl_->writers.size()) - 1;
 }
 
@@ -294,6 +339,7 @@ int DdsParticipant::MatchedWriters(int reader) const {
 }
 
 long long DdsParticipant::too_large() const { return impl_->too_large.load(); }
+long long DdsParticipant::announcements() const { return impl_->announcements; }
 const std::string& DdsParticipant::reader_topic(int reader) const { return impl_->reader_topics.at(reader); }
 const std::string& DdsParticipant::writer_topic(int writer) const { return impl_->writer_topics.at(writer); }
 

@@ -28,6 +28,16 @@ Transform TransformOf(const msgs::Pose2D& p) { return {{p.x, p.y, 0.0}, FromYaw(
 
 }  // namespace
 
+void ParseTreeFrames(config::Section& s, const std::string& what, Frames* f) {
+  f->base_link = s.GetString("base_link_frame", f->base_link,
+                             what +
+                                 ": the frame between the robot's and the lidar's on /tf_static, as the MBot's "
+                                 "robot_state_publisher has it ('' = the lidar straight from the robot's frame)");
+  f->base_link_z_m =
+      s.GetDouble("base_link_z_m", f->base_link_z_m, what + ": base_link above the robot's frame [m]", -10.0, 10.0);
+  f->lidar_z_m = s.GetDouble("lidar_z_m", f->lidar_z_m, what + ": the lidar above base_link [m]", -10.0, 10.0);
+}
+
 bool EventEncoder::Encode(const Event& event, std::vector<EncodedMessage>* out) {
   out_ = out;
   const bool any = msgs::Visit(event, *this);
@@ -82,8 +92,17 @@ bool EventEncoder::Lidar(const Event& ev, const msgs::LidarScan& scan) {
     TFMessage tf;
     TransformStamped t;
     t.header = {StampOf(ev.t_us), frames_.robot};
+    if (!frames_.base_link.empty() && frames_.base_link != frames_.robot) {
+      t.child_frame_id = frames_.base_link;
+      t.transform.translation = {0.0, 0.0, frames_.base_link_z_m};
+      tf.transforms.push_back(t);
+      t.header.frame_id = frames_.base_link;
+    }
     t.child_frame_id = frames_.lidar;
     t.transform = TransformOf(mount_);
+    t.transform.translation.z = frames_.base_link.empty() || frames_.base_link == frames_.robot
+                                    ? frames_.base_link_z_m + frames_.lidar_z_m
+                                    : frames_.lidar_z_m;
     tf.transforms.push_back(t);
     Put("/tf_static", kTFMessageType, ev.t_us, ros2::Encode(tf));
   }

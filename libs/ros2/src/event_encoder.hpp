@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "mbot/common/config.hpp"
 #include "mbot/msgs/visitor.hpp"
 #include "mbot/ros2/messages.hpp"
 #include "mbot/ros2/ros2_transport.hpp"
@@ -20,6 +21,11 @@ struct Frames {
   std::string map = "map", odom = "odom", robot = "base_footprint";
   std::string lidar = "lidar_link", imu = "base_link";
   std::string camera = "camera";  // the image's frame (camera_ros's default): tag detections and their /tf
+  // The MBot's robot_state_publisher tree: robot → base_link (z base_link_z_m), base_link → lidar
+  // (the lidar's planar mount, z lidar_z_m above base_link). base_link "" (or the robot's frame):
+  // the mount straight from the robot's frame.
+  std::string base_link = "base_link";
+  double base_link_z_m = 0.042, lidar_z_m = 0.142;
 };
 
 struct EncodedMessage {
@@ -61,6 +67,10 @@ class EventEncoder : private msgs::EventVisitor {
   bool mount_written_ = false, have_odom_ = false;
   long long binned_ = 0;
 };
+
+// The keys of the robot's /tf_static tree: base_link_frame, base_link_z_m, lidar_z_m (`what`
+// starts their documentation: "ros2", "rosbag2").
+void ParseTreeFrames(config::Section& s, const std::string& what, Frames* frames);
 
 // "completed: detail" → the state and detail (nullopt when the state is not one of ours).
 std::optional<msgs::MissionStatus> ParseMissionState(const std::string& text);

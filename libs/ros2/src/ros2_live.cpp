@@ -55,9 +55,16 @@ Qos ReaderQos(const std::string& wire) {
 
 }  // namespace
 
-Ros2NodeOptions ParseRos2NodeOptions(config::Section& s, const std::string& url) {
+Ros2NodeOptions ParseRos2NodeOptions(config::Section& s, const std::string& url, const std::string& node) {
   Ros2NodeOptions o;
   o.dds.domain_id = ParseDomain(url);
+  o.dds.node_name = s.GetString("node_name", node,
+                                "ros2: the node it is in the ROS 2 graph (ros_discovery_info: `ros2 node list` names "
+                                "it; '' = not announced)");
+  if (!o.dds.node_name.empty() &&
+      o.dds.node_name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") !=
+          std::string::npos)
+    s.Fail("node_name", "a ROS 2 node name is letters, digits and underscores");
   o.dds.max_sample_bytes = static_cast<size_t>(
       s.GetDouble("max_message_mb", o.dds.max_sample_bytes / 1048576.0,
                   "ros2: a message larger than this is dropped on receipt (and counted) [MiB]", 0.001, 4096) *
@@ -77,6 +84,7 @@ Ros2NodeOptions ParseRos2NodeOptions(config::Section& s, const std::string& url)
   o.frames.lidar = s.GetString("lidar_frame", o.frames.lidar, "ros2: the scans' frame (what a simulated robot says)");
   o.frames.imu = s.GetString("imu_frame", o.frames.imu, "ros2: the IMU's frame");
   o.frames.camera = s.GetString("camera_frame", o.frames.camera, "ros2: the camera image's frame (tag detections)");
+  ParseTreeFrames(s, "ros2", &o.frames);
   return o;
 }
 
@@ -287,7 +295,7 @@ msgs::StageType Ros2BridgeStageType() {
         BridgeOptions o;
         const std::string url =
             s.GetString("url", "dds:0", "ros2_bridge: dds:<domain id> (the ROS_DOMAIN_ID of the network)");
-        o.node = ParseRos2NodeOptions(s, url);
+        o.node = ParseRos2NodeOptions(s, url, "mbot_nav_bridge");
         o.publish = s.GetList("publish", o.publish, "channels published (what the robot's firmware and lidar publish)");
         o.subscribe = s.GetList("subscribe", o.subscribe, "channels listened to (the autonomy's commands and outputs)");
         return std::make_unique<Ros2BridgeStage>(o);

@@ -36,7 +36,7 @@ struct Ros2NodeOptions {
 std::string DefaultRosType(const std::string& topic);
 
 // [source] / [stage] keys shared by ros2_live and ros2_bridge: url (dds:<domain>), topics, frames.
-Ros2NodeOptions ParseRos2NodeOptions(config::Section& section, const std::string& url);
+Ros2NodeOptions ParseRos2NodeOptions(config::Section& section, const std::string& url, const std::string& node);
 
 class Ros2Node {
  public:

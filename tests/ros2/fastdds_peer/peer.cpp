@@ -4,7 +4,10 @@
 // reliable, transient local), /odom (25 Hz) and /scan (10 Hz) of a 3 m square room with a gap in
 // its +x wall — and listens to /cmd_vel. Then a reader that joins late asks for /map (reliable,
 // transient local). It exits 0 when the stack commanded a non-zero velocity and the late reader got
-// a map in which the wall at −x is occupied and the gap at +x is not (the mount was applied).
+// a map in which the wall at −x is occupied and the gap at +x is not (the mount was applied), and
+// the autonomy announced itself on ros_discovery_info as rmw_cyclonedds does: a node "/mbot_nav"
+// whose writer GIDs hold the GUID of the writer its /cmd_vel came from, under that writer's
+// participant (what `ros2 node list` and `ros2 node info` read).
 //   mbot_fastdds_peer <domain id> <seconds>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -19,6 +22,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <set>
+#include <string>
 #include <thread>
 
 #include "mbot_ros2PubSubTypes.h"
@@ -70,7 +76,9 @@ int main(int argc, char** argv) {
   TypeSupport tf_t(new tf2_msgs::msg::dds_::TFMessage_PubSubType());
   TypeSupport twist_t(new geo::Twist_PubSubType());
   TypeSupport map_t(new nav_msgs::msg::dds_::OccupancyGrid_PubSubType());
-  for (TypeSupport* t : {&scan_t, &odom_t, &tf_t, &twist_t, &map_t}) t->register_type(pp);
+  TypeSupport info_t(new rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_PubSubType());
+  for (TypeSupport* t : {&scan_t, &odom_t, &tf_t, &twist_t, &map_t, &info_t}) t->register_type(pp);
+  Topic* info_topic = pp->create_topic("ros_discovery_info", info_t.get_type_name(), TOPIC_QOS_DEFAULT);
   Topic* scan_topic = pp->create_topic("rt/scan", scan_t.get_type_name(), TOPIC_QOS_DEFAULT);
   Topic* odom_topic = pp->create_topic("rt/odom", odom_t.get_type_name(), TOPIC_QOS_DEFAULT);
   Topic* tf_topic = pp->create_topic("rt/tf_static", tf_t.get_type_name(), TOPIC_QOS_DEFAULT);
@@ -91,7 +99,13 @@ int main(int argc, char** argv) {
   DataReaderQos cmd_q = DATAREADER_QOS_DEFAULT;
   cmd_q.reliability().kind = RELIABLE_RELIABILITY_QOS;
   DataReader* cmd_r = sub->create_datareader(cmd_topic, cmd_q);
-  if (!scan_w || !odom_w || !tf_w || !cmd_r) return std::fprintf(stderr, "peer: endpoints not created\n"), 2;
+  DataReaderQos info_q = DATAREADER_QOS_DEFAULT;  // as rmw's: reliable, transient local, all kept
+  info_q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  info_q.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
+  info_q.history().kind = KEEP_ALL_HISTORY_QOS;
+  DataReader* info_r = sub->create_datareader(info_topic, info_q);
+  if (!scan_w || !odom_w || !tf_w || !cmd_r || !info_r) return std::fprintf(stderr, "peer: endpoints not created\n"), 2;
+  std::set<std::string> cmd_writers;  // the 16-byte GUIDs /cmd_vel came from
 
   // The lidar's mount, as robot_state_publisher says it: z 0.142 m, yaw 180° (z axis up).
   tf2_msgs::msg::dds_::TFMessage_ tf;
@@ -140,6 +154,11 @@ int main(int argc, char** argv) {
     SampleInfo info;
     while (cmd_r->take_next_sample(&t, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
+      const auto& g = info.sample_identity.writer_guid();
+      std::string guid(16, '\0');
+      std::memcpy(&guid[0], g.guidPrefix.value, 12);
+      std::memcpy(&guid[12], g.entityId.value, 4);
+      cmd_writers.insert(guid);
       ++commands;
       if (std::abs(t.linear().x()) > 1e-6 || std::abs(t.angular().z()) > 1e-6) ++moving;
     }
@@ -181,9 +200,40 @@ int main(int argc, char** argv) {
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
+  // ros_discovery_info: the latest announcement of the participant whose writer sent /cmd_vel.
+  bool node_named = false, writer_listed = false;
+  int announcements = 0;
+  rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_ pinfo;
+  SampleInfo pi;
+  while (info_r->take_next_sample(&pinfo, &pi) == ReturnCode_t::RETCODE_OK) {
+    if (!pi.valid_data) continue;
+    ++announcements;
+    const std::string ppgid(pinfo.gid().data().begin(), pinfo.gid().data().end());
+    for (const auto& node : pinfo.node_entities_info_seq()) {
+      bool mine = false;
+      for (const auto& w : node.writer_gid_seq()) {
+        const std::string gid(w.data().begin(), w.data().end());
+        // The writer's GUID, under its participant's (the same prefix, entity 0x000001c1).
+        if (cmd_writers.count(gid) && ppgid.compare(0, 12, gid, 0, 12) == 0 &&
+            ppgid.substr(12) == std::string("\x00\x00\x01\xc1", 4))
+          mine = true;
+      }
+      if (!mine) continue;
+      writer_listed = true;
+      const std::string ns = node.node_namespace().c_str(), name = node.node_name().c_str();
+      node_named = ns == "/" && name == "mbot_nav";
+      std::printf(
+          "peer: ros_discovery_info names node '%s' in namespace '%s' (%zu readers, %zu writers), /cmd_vel's "
+          "writer among them\n",
+          name.c_str(), ns.c_str(), node.reader_gid_seq().size(), node.writer_gid_seq().size());
+    }
+  }
+  std::printf("peer: %d ros_discovery_info samples\n", announcements);
   pp->delete_contained_entities();
   DomainParticipantFactory::get_instance()->delete_participant(pp);
-  const bool ok = moving > 0 && got_map && wall_seen && gap_open;
-  std::printf("%s\n", ok ? "PASS" : "FAIL: no non-zero /cmd_vel, or no /map for the late reader, or a wrong map");
+  const bool ok = moving > 0 && got_map && wall_seen && gap_open && writer_listed && node_named;
+  std::printf("%s\n", ok ? "PASS"
+                         : "FAIL: no non-zero /cmd_vel, or no /map for the late reader, or a wrong map, or no node "
+                           "/mbot_nav on ros_discovery_info listing /cmd_vel's writer");
   return ok ? 0 : 1;
 }

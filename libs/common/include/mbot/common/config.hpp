@@ -63,6 +63,9 @@ class Config {
 
   // Applies one `section.key=value` override. Throws ConfigError when malformed.
   void Set(const std::string& assignment);
+  // Removes `section.key` (what an included file set that this run must not have: --unset).
+  // Throws ConfigError when the configuration has no such key.
+  void Unset(const std::string& name);
 
   bool HasSection(const std::string& name) const { return sections_.count(name) > 0; }
   std::vector<std::string> SectionNames() const;

@@ -25,6 +25,10 @@ struct DdsOptions {
   int domain_id = 0;                    // ROS_DOMAIN_ID
   size_t max_sample_bytes = 64u << 20;  // larger samples are dropped (and counted) on receipt
   std::string config;                   // Cyclone XML fragments or a file URI ("" = CYCLONEDDS_URI)
+  // The ROS 2 node this participant is (namespace "/"): announced on ros_discovery_info as
+  // rmw_cyclonedds does, with the GIDs of its readers and writers, so `ros2 node list` and
+  // `ros2 node info` name it. "" = no announcement.
+  std::string node_name = "mbot_nav";
 };
 
 class DdsParticipant {
@@ -56,7 +60,8 @@ class DdsParticipant {
   // Remote endpoints matched so far (discovery), for tests and start-up waits.
   int MatchedReaders(int writer) const;
   int MatchedWriters(int reader) const;
-  long long too_large() const;  // samples dropped for exceeding max_sample_bytes
+  long long too_large() const;      // samples dropped for exceeding max_sample_bytes
+  long long announcements() const;  // ParticipantEntitiesInfo samples written on ros_discovery_info
   int domain_id() const { return options_.domain_id; }
   const std::string& reader_topic(int reader) const;
   const std::string& writer_topic(int writer) const;
