@@ -170,8 +170,7 @@ int main(int argc, char** argv) {
       // A robot's bus: OpenMP threads sleep between scans (pipeline.hpp says why). The policy is read
       // when libgomp loads, so the process starts again with it, before any of the plan is built; if
       // that fails it runs as it is.
-      setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
-      execv("/proc/self/exe", argv);
+      if (setenv("OMP_WAIT_POLICY", "PASSIVE", 1) == 0) execv("/proc/self/exe", argv);
     }
     if (mbot::app::IsCompetition(config)) {
       competition = mbot::app::BuildCompetition(config);

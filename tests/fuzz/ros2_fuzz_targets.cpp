@@ -87,9 +87,27 @@ void WriteSeeds(const fs::path& dir) {
     }
     w.Close();
   }
-  for (size_t i = 0; i < samples.size(); ++i) {
+  // The CDR target's seeds: one of each decoder's messages, the selector byte first (Cdr below).
+  std::vector<std::vector<uint8_t>> cdr;
+  for (const auto& sample : samples) cdr.push_back(sample.second);
+  OccupancyGrid grid;
+  grid.info.resolution = 0.05f, grid.info.width = 3, grid.info.height = 2;
+  grid.data = {-1, 0, 100, 0, 0, 100};
+  cdr.push_back(Encode(grid));
+  cdr.push_back(Encode(String{"exploring"}));
+  cdr.push_back(Encode(Encoders{{1, 2}, {100, -100, 0}, {5, -5, 0}, 20000}));
+  cdr.push_back(Encode(MotorVelocity{{1.5f, -1.5f, 0.0f}}));
+  AprilTagDetectionArray tags;
+  tags.header.frame_id = "camera";
+  AprilTagDetection d;
+  d.family = "tagCustom48h12", d.id = 3, d.decision_margin = 80.0f;
+  d.centre = {320, 240}, d.corners = {300, 220, 340, 220, 340, 260, 300, 260},
+  d.homography = {20, 0, 320, 0, 20, 240, 0, 0, 1};
+  tags.detections = {d, d};
+  cdr.push_back(Encode(tags));
+  for (size_t i = 0; i < cdr.size(); ++i) {
     std::vector<uint8_t> input(1, static_cast<uint8_t>(i));
-    input.insert(input.end(), samples[i].second.begin(), samples[i].second.end());
+    input.insert(input.end(), cdr[i].begin(), cdr[i].end());
     std::ofstream((dir / ("seed_cdr_" + std::to_string(i))).string(), std::ios::binary)
         .write(reinterpret_cast<const char*>(input.data()), static_cast<std::streamsize>(input.size()));
   }

@@ -21,8 +21,9 @@ viewer_dir=$(cd "$(dirname "$0")/../viewer" && pwd)
 case $task in
   explore) autonomy_ini=ros2_live.ini robot_ini=sim_robot_ros2.ini limit=150
     extra="--set viewer.enabled=true --set viewer.port=0 --set viewer.http_port=0"
-    command -v node > /dev/null && [ -d "$viewer_dir/node_modules/@foxglove/ws-protocol" ] ||
-      { echo "FAIL: node or $viewer_dir/node_modules is missing: run scripts/install_deps.sh"; exit 1; } ;;
+    command -v node > /dev/null && [ -d "$viewer_dir/node_modules/@foxglove/ws-protocol" ] &&
+      [ -x "${CHROMIUM:-/usr/bin/chromium}" ] ||
+      { echo "FAIL: node, chromium or $viewer_dir/node_modules is missing: run scripts/install_deps.sh"; exit 1; } ;;
   warehouse) autonomy_ini=ros2_live_warehouse.ini robot_ini=sim_robot_ros2_warehouse.ini
     extra="--set mission.deliveries=1" limit=200 ;;
   *) echo "over_ros2.sh: task is explore or warehouse, not '$task'"; exit 2 ;;
@@ -44,16 +45,19 @@ unshare -n bash -c '
   robot=$!
   viewer_rc=0
   if [ "$task" = explore ]; then
-    for _ in $(seq 50); do grep -q "^viewer: Foxglove at" "$out/autonomy.log" && break; sleep 0.1; done
+    for _ in $(seq 100); do grep -q "^viewer: Foxglove at" "$out/autonomy.log" && break; sleep 0.1; done
     line=$(grep -m1 "^viewer: Foxglove at" "$out/autonomy.log")
+    [ -n "$line" ] || { echo "FAIL: the autonomy'"'"'s viewer did not start" > "$out/viewer_clients.log"; viewer_rc=1; }
     ws_url=$(echo "$line" | sed -n "s/.*Foxglove at \(ws:[^ ,]*\).*/\1/p")
     page_url=$(echo "$line" | sed -n "s/.*the page at \(http:[^ ,]*\).*/\1/p")
     echo "$line"
-    sleep 8  # the robot is mapping
-    (cd "$viewer_dir" && node foxglove_client.mjs "$ws_url" 4 "$out/foxglove_client.json" /map /scan /tf /pose \
-      /odom /scene /mission) > "$out/viewer_clients.log" 2>&1 || viewer_rc=1
-    (cd "$viewer_dir" && node browser.mjs "$page_url" "$out/page.png" "$out/browser.json" live) >> "$out/viewer_clients.log" 2>&1 ||
-      viewer_rc=1
+    if [ $viewer_rc -eq 0 ]; then
+      sleep 8  # the robot is mapping
+      (cd "$viewer_dir" && node foxglove_client.mjs "$ws_url" 4 "$out/foxglove_client.json" /map /scan /tf /pose \
+        /odom /scene /mission) > "$out/viewer_clients.log" 2>&1 || viewer_rc=1
+      (cd "$viewer_dir" && node browser.mjs "$page_url" "$out/page.png" "$out/browser.json" live) \
+        >> "$out/viewer_clients.log" 2>&1 || viewer_rc=1
+    fi
   fi
   wait $robot
   robot_rc=$?

@@ -182,6 +182,10 @@ struct DdsParticipant::Impl {
   size_t max_bytes = 0;
 
   dds_entity_t discovery = 0;  // the ros_discovery_info writer
+  ~Impl() {                    // also when the constructor throws: the participant holds threads and sockets
+    if (participant > 0) dds_delete(participant);
+    if (domain > 0) dds_delete(domain);
+  }
   std::string node_name;
   long long announcements = 0;
 
@@ -264,10 +268,7 @@ DdsParticipant::DdsParticipant(const DdsOptions& options) : impl_(std::make_uniq
   }
 }
 
-DdsParticipant::~DdsParticipant() {
-  if (impl_->participant > 0) dds_delete(impl_->participant);
-  if (impl_->domain > 0) dds_delete(impl_->domain);
-}
+DdsParticipant::~DdsParticipant() = default;
 
 int DdsParticipant::AddReader(const std::string& topic, const std::string& type, const Qos& q) {
   dds_qos_t* qos = QosOf(q);

@@ -174,8 +174,8 @@ AprilTagDetectionArray DecodeAprilTagDetectionArray(const uint8_t* data, size_t 
   CdrReader r = Reader(data, size, serialization);
   AprilTagDetectionArray m;
   m.header = ReadHeader(r);
-  // Each detection: a string (4 + 1 at least), four int32/float32 and 19 float64.
-  m.detections.resize(r.Count("detections", 4 + 1 + 16 + 19 * 8));
+  // Each detection: a string (its length, and CDR's NUL), four int32/float32 and 19 float64.
+  m.detections.resize(r.Count("detections", (r.ros1() ? 4 : 5) + 16 + 19 * 8));
   for (AprilTagDetection& d : m.detections) {
     d.family = r.String("detections.family");
     d.id = r.I32("detections.id");

@@ -20,6 +20,7 @@ std::string DefaultRosType(const std::string& topic) {
                                                            {topics::kOdometry, kOdometryType},
                                                            {topics::kImu, kImuType},
                                                            {topics::kEncoders, kEncodersType},
+                                                           {topics::kMotorVelocity, kMotorVelocityType},
                                                            {topics::kVelocityCommand, kTwistType},
                                                            {topics::kSlamMap, kOccupancyGridType},
                                                            {topics::kSlamPose, kPoseStampedType},
@@ -84,7 +85,6 @@ Ros2NodeOptions ParseRos2NodeOptions(config::Section& s, const std::string& url,
   o.frames.lidar = s.GetString("lidar_frame", o.frames.lidar, "ros2: the scans' frame (what a simulated robot says)");
   o.frames.imu = s.GetString("imu_frame", o.frames.imu, "ros2: the IMU's frame");
   o.frames.camera = s.GetString("camera_frame", o.frames.camera, "ros2: the camera image's frame (tag detections)");
-  ParseTreeFrames(s, "ros2", &o.frames);
   return o;
 }
 
@@ -296,6 +296,7 @@ msgs::StageType Ros2BridgeStageType() {
         const std::string url =
             s.GetString("url", "dds:0", "ros2_bridge: dds:<domain id> (the ROS_DOMAIN_ID of the network)");
         o.node = ParseRos2NodeOptions(s, url, "mbot_nav_bridge");
+        ParseTreeFrames(s, "ros2_bridge", &o.node.frames);  // the robot's side publishes the mount
         o.publish = s.GetList("publish", o.publish, "channels published (what the robot's firmware and lidar publish)");
         o.subscribe = s.GetList("subscribe", o.subscribe, "channels listened to (the autonomy's commands and outputs)");
         return std::make_unique<Ros2BridgeStage>(o);

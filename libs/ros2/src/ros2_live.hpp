@@ -78,7 +78,6 @@ class Ros2Node {
   std::map<std::string, std::string> writer_types_;
   std::map<std::string, TopicStats> stats_;
   std::vector<EncodedMessage> encoded_;
-  std::vector<msgs::Event>* sink_ = nullptr;
 };
 
 std::unique_ptr<msgs::Source> OpenRos2Live(const msgs::SourceOptions& options);

@@ -68,8 +68,8 @@ RunSummary RunPlan(PipelinePlan& plan, const std::atomic<bool>& stop);
 // spin — libgomp's default spin after each parallel region cost the live autonomy ~7 % of a core
 // (BENCHMARKS.md, "Live path"). The wait policy is read once at load, from OMP_WAIT_POLICY; the
 // app re-executes itself with OMP_WAIT_POLICY=PASSIVE when this is true and it is unset. It reads
-// the configuration's [source] type only, so the app can decide before building the plan (which
-// opens the bus and sizes the maps: building it twice cost ~0.4 CPU-s at every live start).
+// the configuration's [source] type only, so the app decides before building the plan (which opens
+// the bus) and builds it once. The second start itself costs ~0.2 CPU-s (loading the libraries).
 bool SourceIsABus(const config::Config& config);
 
 }  // namespace mbot::pipeline
