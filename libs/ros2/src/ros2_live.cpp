@@ -303,4 +303,51 @@ msgs::StageType Ros2BridgeStageType() {
       }};
 }
 
+namespace {
+
+class Ros2Output : public msgs::Output {
+ public:
+  explicit Ros2Output(Ros2NodeOptions o) : o_(std::move(o)) {}
+  void Open(const msgs::RunContext& /*context*/) override {
+    node_ = std::make_unique<Ros2Node>(o_, std::vector<std::string>{}, msgs::ChannelRoles{});
+    mbot::log::Info("output ros2: publishing on " + node_->where() + " as node /" + o_.dds.node_name);
+  }
+  void Send(const Event& event) override {
+    if (node_ && !node_->Publish(event)) ++unsent_[msgs::ToString(event.kind)];
+  }
+  void Close(bool /*interrupted*/) override {
+    if (!node_) return;
+    std::string counts, unsent;
+    for (const auto& [wire, st] : node_->stats()) {
+      if (st.published > 0) counts += (counts.empty() ? "" : ", ") + wire + " " + std::to_string(st.published);
+    }
+    for (const auto& [kind, n] : unsent_) unsent += (unsent.empty() ? "" : ", ") + kind + " " + std::to_string(n);
+    mbot::log::Info("output ros2: published " + (counts.empty() ? std::string("nothing") : counts) +
+                    (unsent.empty() ? "" : "; no ROS 2 message for " + unsent));
+    node_.reset();
+  }
+
+ private:
+  Ros2NodeOptions o_;
+  std::unique_ptr<Ros2Node> node_;
+  std::map<std::string, long long> unsent_;
+};
+
+}  // namespace
+
+msgs::OutputType Ros2OutputType() {
+  msgs::OutputType t;
+  t.name = "ros2";
+  t.doc =
+      "publishes the run's events over DDS as the MBot's ROS 2 messages, topics and QoS (url dds:<domain>): a "
+      "replay or a simulation seen in RViz or Foxglove over ROS 2; /map and /tf_static transient local";
+  t.create = [](config::Section& s) -> std::unique_ptr<msgs::Output> {
+    const std::string url = s.GetString("url", "dds:0", "ros2: dds:<domain id> (the ROS_DOMAIN_ID of the network)");
+    Ros2NodeOptions o = ParseRos2NodeOptions(s, url, "mbot_nav_replay");
+    ParseTreeFrames(s, "ros2", &o.frames);
+    return std::make_unique<Ros2Output>(std::move(o));
+  };
+  return t;
+}
+
 }  // namespace mbot::ros2

@@ -82,6 +82,9 @@ class Ros2Node {
 
 std::unique_ptr<msgs::Source> OpenRos2Live(const msgs::SourceOptions& options);
 msgs::StageType Ros2BridgeStageType();
+// output ros2: the run's events published over DDS as the MBot's messages (a replay or a simulation
+// seen in RViz or Foxglove over ROS 2, or driving other ROS 2 nodes).
+msgs::OutputType Ros2OutputType();
 
 // [source] type = ros2_live: the node's options and the live keys.
 struct Ros2LiveOptions {

@@ -108,6 +108,7 @@ void RegisterRos2Transport() {
   live.default_url = "dds:0";
   msgs::RegisterSourceType(std::move(live));
   msgs::RegisterStageType(Ros2BridgeStageType());
+  msgs::RegisterOutputType(Ros2OutputType());
   msgs::OutputType recorder;
   recorder.name = "rosbag2";
   recorder.doc =

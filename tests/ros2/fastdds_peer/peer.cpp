@@ -8,7 +8,7 @@
 // the autonomy announced itself on ros_discovery_info as rmw_cyclonedds does: a node "/mbot_nav"
 // whose writer GIDs hold the GUID of the writer its /cmd_vel came from, under that writer's
 // participant (what `ros2 node list` and `ros2 node info` read).
-//   mbot_fastdds_peer <domain id> <seconds>
+//   mbot_fastdds_peer <domain id> <seconds> [listen]
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
@@ -66,11 +66,91 @@ struct Endpoint {
 
 }  // namespace
 
+// `listen`: RViz's side of a replay published over DDS (mbot_nav's `ros2` output). For `seconds`
+// it reads /scan and /tf (best effort, as RViz does), then a late reader asks for /map and
+// /tf_static (reliable, transient local). Exits 0 when scans of 100+ beams and odom → base_footprint
+// transforms came, the late reader got a map with occupied and free cells, and /tf_static holds the
+// lidar's mount through base_link.
+int Listen(DomainParticipant* pp, double seconds) {
+  TypeSupport scan_t(new sensor_msgs::msg::dds_::LaserScan_PubSubType());
+  TypeSupport tf_t(new tf2_msgs::msg::dds_::TFMessage_PubSubType());
+  TypeSupport map_t(new nav_msgs::msg::dds_::OccupancyGrid_PubSubType());
+  for (TypeSupport* t : {&scan_t, &tf_t, &map_t}) t->register_type(pp);
+  Subscriber* sub = pp->create_subscriber(SUBSCRIBER_QOS_DEFAULT);
+  DataReaderQos sensor = DATAREADER_QOS_DEFAULT;
+  sensor.reliability().kind = BEST_EFFORT_RELIABILITY_QOS;
+  DataReaderQos latched = DATAREADER_QOS_DEFAULT;
+  latched.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  latched.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
+  DataReader* scan_r =
+      sub->create_datareader(pp->create_topic("rt/scan", scan_t.get_type_name(), TOPIC_QOS_DEFAULT), sensor);
+  DataReader* tf_r = sub->create_datareader(pp->create_topic("rt/tf", tf_t.get_type_name(), TOPIC_QOS_DEFAULT), sensor);
+  if (!scan_r || !tf_r) return std::fprintf(stderr, "peer: readers not created\n"), 2;
+  long scans = 0, wide = 0, odom_tf = 0;
+  const auto start = Clock::now();
+  while (Clock::now() - start < std::chrono::duration<double>(seconds)) {
+    sensor_msgs::msg::dds_::LaserScan_ scan;
+    SampleInfo info;
+    while (scan_r->take_next_sample(&scan, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      ++scans;
+      if (scan.ranges().size() >= 100 && scan.header().frame_id() == "lidar_link") ++wide;
+    }
+    tf2_msgs::msg::dds_::TFMessage_ tf;
+    while (tf_r->take_next_sample(&tf, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      for (const auto& t : tf.transforms()) {
+        if (t.header().frame_id() == "odom" && t.child_frame_id() == "base_footprint") ++odom_tf;
+      }
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  std::printf("peer: %ld /scan (%ld of 100+ beams in lidar_link), %ld odom -> base_footprint on /tf\n", scans, wide,
+              odom_tf);
+  DataReader* map_r =
+      sub->create_datareader(pp->create_topic("rt/map", map_t.get_type_name(), TOPIC_QOS_DEFAULT), latched);
+  DataReader* static_r =
+      sub->create_datareader(pp->create_topic("rt/tf_static", tf_t.get_type_name(), TOPIC_QOS_DEFAULT), latched);
+  bool map_ok = false, mount_ok = false;
+  const auto wait_end = Clock::now() + std::chrono::seconds(5);
+  while ((!map_ok || !mount_ok) && Clock::now() < wait_end) {
+    nav_msgs::msg::dds_::OccupancyGrid_ g;
+    SampleInfo info;
+    while (map_r && map_r->take_next_sample(&g, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      long occupied = 0, free_cells = 0;
+      for (int8_t v : g.data()) occupied += v == 100, free_cells += v == 0;
+      map_ok = g.info().width() > 0 && occupied > 0 && free_cells > 0;
+      std::printf("peer: late reader got /map %ux%u (%ld occupied, %ld free)\n", g.info().width(), g.info().height(),
+                  occupied, free_cells);
+    }
+    tf2_msgs::msg::dds_::TFMessage_ tf;
+    while (static_r && static_r->take_next_sample(&tf, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      bool base = false, lidar = false;
+      for (const auto& t : tf.transforms()) {
+        base = base || (t.header().frame_id() == "base_footprint" && t.child_frame_id() == "base_link");
+        lidar = lidar || (t.header().frame_id() == "base_link" && t.child_frame_id() == "lidar_link");
+      }
+      mount_ok = base && lidar;
+      std::printf("peer: late reader got /tf_static (%zu transforms%s)\n", tf.transforms().size(),
+                  mount_ok ? ": base_footprint -> base_link -> lidar_link" : "");
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  pp->delete_contained_entities();
+  DomainParticipantFactory::get_instance()->delete_participant(pp);
+  const bool ok = wide > 0 && odom_tf > 0 && map_ok && mount_ok;
+  std::printf("%s\n", ok ? "PASS" : "FAIL: no scans, no odom transforms, no map or no mount for the late reader");
+  return ok ? 0 : 1;
+}
+
 int main(int argc, char** argv) {
   const int domain = argc > 1 ? std::atoi(argv[1]) : 0;
   const double seconds = argc > 2 ? std::atof(argv[2]) : 8.0;
   DomainParticipant* pp = DomainParticipantFactory::get_instance()->create_participant(domain, PARTICIPANT_QOS_DEFAULT);
   if (!pp) return std::fprintf(stderr, "peer: no participant\n"), 2;
+  if (argc > 3 && std::string(argv[3]) == "listen") return Listen(pp, seconds);
   TypeSupport scan_t(new sensor_msgs::msg::dds_::LaserScan_PubSubType());
   TypeSupport odom_t(new nav_msgs::msg::dds_::Odometry_PubSubType());
   TypeSupport tf_t(new tf2_msgs::msg::dds_::TFMessage_PubSubType());
