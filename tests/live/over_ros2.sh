@@ -12,11 +12,6 @@
 #   over_ros2.sh <mbot_nav> <config dir> <output dir> explore|warehouse [seed]
 set -u
 bin=$1 config=$2 out=$3 task=$4 seed=${5:-2}
-if ! unshare -n true 2>/dev/null; then
-  echo "SKIPPED: cannot create a network namespace here (unshare -n not permitted); the live test needs one"
-  exit 77
-fi
-command -v ip > /dev/null || { echo "SKIPPED: ip is not installed; scripts/install_deps.sh installs it"; exit 77; }
 viewer_dir=$(cd "$(dirname "$0")/../viewer" && pwd)
 case $task in
   explore) autonomy_ini=ros2_live.ini robot_ini=sim_robot_ros2.ini limit=150
@@ -30,10 +25,8 @@ case $task in
 esac
 rm -rf "$out" && mkdir -p "$out"
 export bin config out seed autonomy_ini robot_ini extra limit task viewer_dir
-unshare -n bash -c '
+"$(dirname "$0")/in_netns.sh" bash -c '
   set -u
-  ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo ||
-    { echo "cannot set up loopback multicast"; exit 1; }
   "$bin" --config "$config/$autonomy_ini" --set output.dir="$out/autonomy" --set source.end_after_silence_s=5 \
     --set pipeline.seed=$seed $extra --set pipeline.progress=off > "$out/autonomy.log" 2>&1 &
   autonomy=$!
@@ -67,6 +60,7 @@ unshare -n bash -c '
   exit $(( robot_rc != 0 || autonomy_rc != 0 || viewer_rc != 0 ))
 '
 rc=$?
+[ $rc -eq 77 ] && exit 77  # no network namespace here (in_netns.sh said why)
 echo "--- robot (simulator + referee)"; tail -12 "$out/robot.log"
 echo "--- autonomy"; grep -E "ros2|viewer|mission: (lifting|setting_down|completed|failed)|error" "$out/autonomy.log" | tail -10
 [ -f "$out/viewer_clients.log" ] && { echo "--- Foxglove's client and Chromium"; tail -15 "$out/viewer_clients.log"; }

@@ -8,16 +8,11 @@
 #   fastdds_interop.sh <mbot_nav> <mbot_fastdds_peer> <config dir> <output dir>
 set -u
 bin=$1 peer=$2 config=$3 out=$4
-if ! unshare -n true 2>/dev/null; then
-  echo "SKIPPED: cannot create a network namespace here (unshare -n not permitted)"
-  exit 77
-fi
-command -v ip > /dev/null || { echo "SKIPPED: ip (iproute2) is not installed; scripts/install_deps.sh installs it"; exit 77; }
+netns=$(cd "$(dirname "$0")/../live" && pwd)/in_netns.sh
 rm -rf "$out" && mkdir -p "$out"
 export bin peer config out
-unshare -n bash -c '
+"$netns" bash -c '
   set -u
-  ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo || exit 1
   "$bin" --config "$config/ros2_live.ini" --set output.dir="$out/autonomy" --set source.end_after_silence_s=3 \
     --set source.duration_s=60 --set pipeline.progress=off > "$out/autonomy.log" 2>&1 &
   autonomy=$!
@@ -30,6 +25,7 @@ unshare -n bash -c '
   exit $(( peer_rc != 0 || autonomy_rc != 0 ))
 '
 rc=$?
+[ $rc -eq 77 ] && exit 77  # no network namespace here (in_netns.sh said why)
 echo "--- Fast DDS peer"; cat "$out/peer.log"
 echo "--- autonomy"; grep -E "ros2|error" "$out/autonomy.log" | tail -6
 [ $rc -eq 0 ] || { echo "FAIL"; exit 1; }

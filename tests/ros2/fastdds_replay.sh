@@ -7,11 +7,7 @@
 #   fastdds_replay.sh <mbot_nav> <mbot_fastdds_peer> <config dir> <output dir>   (MBOT_DATASETS_DIR)
 set -u
 bin=$1 peer=$2 config=$3 out=$4
-if ! unshare -n true 2>/dev/null; then
-  echo "SKIPPED: cannot create a network namespace here (unshare -n not permitted)"
-  exit 77
-fi
-command -v ip > /dev/null || { echo "SKIPPED: ip (iproute2) is not installed; scripts/install_deps.sh installs it"; exit 77; }
+netns=$(cd "$(dirname "$0")/../live" && pwd)/in_netns.sh
 if [ ! -d "${MBOT_DATASETS_DIR:-}/botlab" ]; then
   echo "no shared datasets at '${MBOT_DATASETS_DIR:-}' (the replay needs a botlab log)"
   if [ "${CI:-}" = true ]; then echo "FAIL: CI needs them"; exit 1; fi
@@ -19,9 +15,8 @@ if [ ! -d "${MBOT_DATASETS_DIR:-}/botlab" ]; then
 fi
 rm -rf "$out" && mkdir -p "$out"
 export bin peer config out
-unshare -n bash -c '
+"$netns" bash -c '
   set -u
-  ip link set lo up && ip link set lo multicast on && ip route add 224.0.0.0/4 dev lo || exit 1
   "$bin" --config "$config/slam_replay.ini" --set output.dir="$out/replay" --set pipeline.progress=off \
     --set pipeline.playback_speed=1 --set pipeline.outputs=dds --set dds.type=ros2 > "$out/replay.log" 2>&1 &
   replay=$!
@@ -36,6 +31,7 @@ unshare -n bash -c '
   exit $(( peer_rc != 0 || (replay_rc != 0 && replay_rc != 130) ))
 '
 rc=$?
+[ $rc -eq 77 ] && exit 77  # no network namespace here (in_netns.sh said why)
 echo "--- Fast DDS peer"; cat "$out/peer.log"
 echo "--- replay"; grep -E "output ros2|interrupted|done|error" "$out/replay.log" | tail -4
 [ $rc -eq 0 ] || { echo "FAIL"; exit 1; }

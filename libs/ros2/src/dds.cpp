@@ -9,11 +9,11 @@
 #include <dds/ddsi/q_radmin.h>
 
 #include <atomic>
-#include <chrono>
 #include <cstring>
 #include <map>
 #include <stdexcept>
 
+#include "mbot/msgs/live_source.hpp"  // WallClockUs
 #include "mbot/ros2/cdr.hpp"
 
 namespace mbot::ros2 {
@@ -40,10 +40,6 @@ struct RawSample : ddsi_serdata {
   std::vector<uint8_t> bytes;  // the CDR payload, with its encapsulation header
   int64_t arrival_us = 0;      // when Cyclone's receive thread got it (wall clock)
 };
-int64_t NowUs() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 struct Blob {  // what dds_write takes
   const uint8_t* data;
   size_t size;
@@ -68,7 +64,7 @@ uint32_t GetSize(const ddsi_serdata* d) {
 ddsi_serdata* FromSer(const ddsi_sertype* type, ddsi_serdata_kind kind, const nn_rdata* frag, size_t size) {
   if (TooLarge(type, size)) return nullptr;  // Cyclone drops a sample it cannot deserialize
   RawSample* d = NewSample(type, kind);
-  d->arrival_us = NowUs();
+  d->arrival_us = msgs::WallClockUs();
   d->bytes.resize(size);
   uint32_t off = 0;
   for (; frag; frag = frag->nextfrag) {  // fragments in order; they may overlap
@@ -84,7 +80,7 @@ ddsi_serdata* FromSerIov(const ddsi_sertype* type, ddsi_serdata_kind kind, ddsrt
                          const ddsrt_iovec_t* iov, size_t size) {
   if (TooLarge(type, size)) return nullptr;
   RawSample* d = NewSample(type, kind);
-  d->arrival_us = NowUs();
+  d->arrival_us = msgs::WallClockUs();
   d->bytes.reserve(size);
   for (ddsrt_msg_iovlen_t i = 0; i < niov; ++i) {
     const auto* p = static_cast<const uint8_t*>(iov[i].iov_base);
@@ -187,7 +183,6 @@ struct DdsParticipant::Impl {
     if (domain > 0) dds_delete(domain);
   }
   std::string node_name;
-  long long announcements = 0;
 
   // rmw_dds_common/msg/ParticipantEntitiesInfo (Jazzy: a Gid is char[16], the entity's DDS GUID):
   // this participant, one node, the GIDs of its readers and writers.
@@ -210,7 +205,7 @@ struct DdsParticipant::Impl {
     gid(discovery);
     const std::vector<uint8_t>& bytes = w.bytes();
     const Blob blob{bytes.data(), bytes.size()};
-    if (dds_write(discovery, &blob) == DDS_RETCODE_OK) ++announcements;
+    dds_write(discovery, &blob);
   }
 
   dds_entity_t Topic(const std::string& topic, const std::string& type, bool ros_name = true) {
@@ -319,7 +314,7 @@ void DdsParticipant::Take(int timeout_ms, const std::function<void(const Sample&
         const auto* s = static_cast<const RawSample*>(got[k]);
         if (info[k].valid_data && !s->bytes.empty())
           on_sample({static_cast<int>(i), s->bytes.data(), s->bytes.size(), info[k].source_timestamp / 1000,
-                     s->arrival_us ? s->arrival_us : NowUs()});
+                     s->arrival_us ? s->arrival_us : msgs::WallClockUs()});
         ddsi_serdata_unref(got[k]);
       }
       if (static_cast<uint32_t>(n) < kBatch) break;
@@ -340,7 +335,6 @@ int DdsParticipant::MatchedWriters(int reader) const {
 }
 
 long long DdsParticipant::too_large() const { return impl_->too_large.load(); }
-long long DdsParticipant::announcements() const { return impl_->announcements; }
 const std::string& DdsParticipant::reader_topic(int reader) const { return impl_->reader_topics.at(reader); }
 const std::string& DdsParticipant::writer_topic(int writer) const { return impl_->writer_topics.at(writer); }
 

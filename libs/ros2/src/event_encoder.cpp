@@ -92,7 +92,8 @@ bool EventEncoder::Lidar(const Event& ev, const msgs::LidarScan& scan) {
     TFMessage tf;
     TransformStamped t;
     t.header = {StampOf(ev.t_us), frames_.robot};
-    if (!frames_.base_link.empty() && frames_.base_link != frames_.robot) {
+    const bool via_base_link = !frames_.base_link.empty() && frames_.base_link != frames_.robot;
+    if (via_base_link) {
       t.child_frame_id = frames_.base_link;
       t.transform.translation = {0.0, 0.0, frames_.base_link_z_m};
       tf.transforms.push_back(t);
@@ -100,9 +101,7 @@ bool EventEncoder::Lidar(const Event& ev, const msgs::LidarScan& scan) {
     }
     t.child_frame_id = frames_.lidar;
     t.transform = TransformOf(mount_);
-    t.transform.translation.z = frames_.base_link.empty() || frames_.base_link == frames_.robot
-                                    ? frames_.base_link_z_m + frames_.lidar_z_m
-                                    : frames_.lidar_z_m;
+    t.transform.translation.z = frames_.lidar_z_m + (via_base_link ? 0.0 : frames_.base_link_z_m);
     tf.transforms.push_back(t);
     Put("/tf_static", kTFMessageType, ev.t_us, ros2::Encode(tf));
   }

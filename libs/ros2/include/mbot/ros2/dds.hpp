@@ -60,8 +60,7 @@ class DdsParticipant {
   // Remote endpoints matched so far (discovery), for tests and start-up waits.
   int MatchedReaders(int writer) const;
   int MatchedWriters(int reader) const;
-  long long too_large() const;      // samples dropped for exceeding max_sample_bytes
-  long long announcements() const;  // ParticipantEntitiesInfo samples written on ros_discovery_info
+  long long too_large() const;  // samples dropped for exceeding max_sample_bytes
   int domain_id() const { return options_.domain_id; }
   const std::string& reader_topic(int reader) const;
   const std::string& writer_topic(int writer) const;
