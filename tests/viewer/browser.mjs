@@ -5,7 +5,7 @@
 // With `control` (the viewer's control on, the mission following): a click on the map sets a goal
 // and the simulated robot must arrive there; W held drives it forward and releasing it stops it.
 import puppeteer from "puppeteer-core";
-import { existsSync, mkdirSync, readFileSync, writeFileSync } from "fs";
+import { existsSync, mkdirSync, readdirSync, readFileSync, rmSync, statSync, writeFileSync } from "fs";
 import { dirname, join } from "path";
 
 const [url, screenshotPath, reportPath, mode] = process.argv.slice(2);
@@ -135,13 +135,18 @@ async function extras(page) {
         `grid ${held.cells} cells, ${held.tinted} within 0.5 m of a wall)`);
   await page.click("#show_distances");
   const dir = join(dirname(reportPath), "downloads");
+  rmSync(dir, { recursive: true, force: true });  // a file from an earlier run proves nothing
   mkdirSync(dir, { recursive: true });
   const cdp = await page.createCDPSession();
   await cdp.send("Browser.setDownloadBehavior", { behavior: "allow", downloadPath: dir });
   const grid = await page.evaluate(() => { const m = window.mbotViewer.map; return { cols: m.column_count, rows: atob(m.data).length / m.row_stride, res: m.cell_size.x, x: m.pose.position.x, y: m.pose.position.y }; });
   await page.click("#save_pgm");
   await page.click("#save_png");
-  for (let i = 0; i < 50 && !["map.pgm", "map.yaml", "map.png"].every((n) => existsSync(join(dir, n))); ++i) await sleep(100);
+  // Chromium makes each download's final name as an empty placeholder and renames the finished
+  // .crdownload over it: a file is there once it has bytes and no partial download is left.
+  const saved = () => ["map.pgm", "map.yaml", "map.png"].every((n) => existsSync(join(dir, n)) && statSync(join(dir, n)).size > 0) &&
+    !readdirSync(dir).some((n) => n.endsWith(".crdownload"));
+  for (let i = 0; i < 100 && !saved(); ++i) await sleep(100);
   const pgmOk = existsSync(join(dir, "map.pgm")) && existsSync(join(dir, "map.yaml"));
   let header = "", yaml = "";
   if (pgmOk) {
