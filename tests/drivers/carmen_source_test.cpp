@@ -47,6 +47,9 @@ TEST(CarmenSourceTest, ParsesOldAndNewLinesKeepingPoseAndOdometryApart) {
   EXPECT_NEAR(std::get<msgs::Pose2D>(ev[2].payload).x, 0.1, 1e-12);
   EXPECT_EQ(ev[3].kind, EventKind::kOdometry);
   EXPECT_NEAR(std::get<msgs::Pose2D>(ev[3].payload).x, 0.4, 1e-12);
+  EXPECT_EQ(ev[4].channel, "ROBOTLASER1.odom");  // its robot pose fields: the odometry at the scan
+  EXPECT_EQ(ev[4].kind, EventKind::kOdometry);
+  EXPECT_NEAR(std::get<msgs::Pose2D>(ev[4].payload).x, 0.0, 1e-12);
   EXPECT_EQ(ev[5].channel, "ROBOTLASER1");
   const auto& rl = std::get<LidarScan>(ev[5].payload);
   EXPECT_NEAR(rl.angles_rad[2] - rl.angles_rad[1], 1.5708, 1e-5);

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -106,8 +107,7 @@ void MapRelations(const std::string& relations, const std::vector<int64_t>& from
 }
 
 // The Intel log as ROS 1 bags made by another project, through the same graph_slam.ini as the
-// CARMEN log (`--unset source.carmen_order --set source.path=<bag> --set
-// slam.odometry_channel=MBOT_ODOMETRY`):
+// CARMEN log, unchanged (`--set source.path=<bag>`):
 // intel.orig.bag keeps the log's stamps (its scans in time order, every ODOM line as /odom, the
 // relations as they are); intel.clf2bag.bag restamps the scans and their odometry 0.1 s apart (the
 // relations moved to the same scans' new stamps). Over the same scans (the first `clf_events` events
@@ -123,7 +123,7 @@ void ExpectBagsScoreAsTheClf(long long clf_events, const std::string& tag) {
   const double clf_scored = Get(clf, {"relations", "scored"});
   ::testing::Test::RecordProperty("clf_translation_m", std::to_string(clf_trans));
   ::testing::Test::RecordProperty("clf_rotation_deg", std::to_string(clf_rot));
-  const Scans clf_scans = ReadScans(Data("carmen/intel-raw.clf.gz"), "carmen_order = file\n");
+  const Scans clf_scans = ReadScans(Data("carmen/intel-raw.clf.gz"));
   size_t replayed = clf_scans.stamps.size();  // scans within the CARMEN run's events
   if (clf_events > 0) {
     replayed = 0;
@@ -136,24 +136,20 @@ void ExpectBagsScoreAsTheClf(long long clf_events, const std::string& tag) {
     ASSERT_EQ(scans.stamps.size(), clf_scans.stamps.size());
     std::string relations = Data("carmen/intel.relations");
     size_t last = replayed;  // the bag's events up to the same scans
-    std::vector<std::string> bag_sets;
     if (std::string(bag) == "intel.clf2bag.bag") {
       relations = ::testing::TempDir() + "/" + bag + ".relations";
       MapRelations(Data("carmen/intel.relations"), clf_scans.stamps, scans.stamps, relations);
     } else {
-      // Its odometry has gaps of up to 3.1 s in the last quarter of the log (72 scans lie in gaps
-      // over the config's 2 s, where the CARMEN log has each scan's own odometry).
-      bag_sets.push_back("slam.max_pose_gap_s=4");
+      // Its odometry has gaps of up to 3.1 s in the last quarter of the log (the config's
+      // max_pose_gap_s = 4 spans them; the CARMEN log has each scan's own odometry).
       // In time order: up to the latest of the CARMEN run's scans.
       int64_t latest = INT64_MIN;
       for (size_t i = 0; i < replayed; ++i) latest = std::max(latest, clf_scans.stamps[i]);
       last = 0;
       while (last < scans.stamps.size() && scans.stamps[last] <= latest) ++last;
     }
-    std::vector<std::string> sets = {"--unset source.carmen_order", "source.path=" + path,
-                                     "slam.odometry_channel=MBOT_ODOMETRY", "slam.relations=" + relations,
+    std::vector<std::string> sets = {"source.path=" + path, "slam.relations=" + relations,
                                      "slam.graph_background=false"};
-    sets.insert(sets.end(), bag_sets.begin(), bag_sets.end());
     if (clf_events > 0 && last < scans.stamps.size())
       sets.push_back("pipeline.max_events=" + std::to_string(scans.events_before[last]));
     const std::string j =
@@ -199,6 +195,105 @@ TEST(GraphSlamFull, IntelEveryRelationWithinTheBenchmarkBounds) {
 }
 
 TEST(GraphSlamFull, IntelRos1BagsScoreAsTheCarmenLog) { ExpectBagsScoreAsTheClf(0, "full"); }
+
+// ACES (Beeson's building, 180° laser to 50 m), the second building of the benchmark, through the
+// same config/graph_slam.ini with only the log and its relations changed. Cartographer's published
+// figures on it (Hess et al. 2016, Table II): 0.0375 m and 0.373°.
+constexpr double kCartographerAcesM = 0.0375, kCartographerAcesDeg = 0.373;
+std::vector<std::string> AcesSets(std::vector<std::string> more = {}) {
+  std::vector<std::string> sets = {"source.path=" + Data("carmen/aces-raw.clf.gz"),
+                                   "slam.relations=" + Data("carmen/aces.relations")};
+  sets.insert(sets.end(), more.begin(), more.end());
+  return sets;
+}
+
+TEST(GraphSlamRegression, AcesFirstFiveMinutesBelowCartographer) {
+  const std::string j =
+      RunConfig("graph_slam.ini", "graph_slam_aces_start",
+                AcesSets({"pipeline.max_events=6000", "slam.graph_background=false"}), "metrics.json");
+  ASSERT_FALSE(j.empty());
+  const double trans = Get(j, {"relations", "translation_m", "mean"});
+  const double rot = Get(j, {"relations", "rotation_deg", "mean"});
+  ::testing::Test::RecordProperty("relations_scored", std::to_string(Get(j, {"relations", "scored"})));
+  ::testing::Test::RecordProperty("translation_m", std::to_string(trans));
+  ::testing::Test::RecordProperty("rotation_deg", std::to_string(rot));
+  EXPECT_GE(Get(j, {"relations", "scored"}), 200);
+  EXPECT_LE(trans, kCartographerAcesM);
+  EXPECT_LE(rot, kCartographerAcesDeg);
+  EXPECT_GT(Get(j, {"graph", "loop_closures"}), 50);
+}
+
+// The Freiburg hospital's format: ROBOTLASER1 lines (laser geometry and range limit in the line, the
+// robot's odometry pose beside the laser's) and no ODOM line. The first `lines` lines of ACES
+// rewritten so: the unchanged config reads the odometry from the scan lines and scores as the
+// FLASER log does.
+std::string AcesAsRobotLaser(int lines) {
+  const std::string out = ::testing::TempDir() + "/aces_robotlaser.log";
+  auto c = config::Config::FromString("[source]\ntype = auto\npath = " + Data("carmen/aces-raw.clf.gz") + "\n");
+  config::Section s = c.GetSection("source");
+  auto source = msgs::OpenSource(msgs::ParseSourceOptions(s));
+  std::ofstream o(out);
+  o.precision(17);
+  int written = 0;
+  std::optional<msgs::LidarScan> scan;
+  while (auto ev = source->Next()) {
+    if (ev->kind == msgs::EventKind::kLidar) scan = std::get<msgs::LidarScan>(ev->payload);
+    if (ev->channel != "FLASER.odom" || !scan) continue;
+    const auto& p = std::get<msgs::Pose2D>(ev->payload);
+    // As the reader places ACES's 180 FLASER beams (CARMEN's rule: 1° apart, centred).
+    if (scan->ranges_m.size() != 180u) ADD_FAILURE() << "ACES scans have 180 beams";
+    const double inc = M_PI / 180, start = -inc * 179 / 2;
+    o << "ROBOTLASER1 0 " << start << " " << inc * 179 << " " << inc << " "
+      << scan->max_range_m << " 0.01 0 " << scan->ranges_m.size();
+    for (float r : scan->ranges_m) o << " " << r;
+    const double t = ev->stamp_us * 1e-6;
+    o << " 0 " << p.x << " " << p.y << " " << p.theta << " " << p.x << " " << p.y << " " << p.theta << " 0 0 0 0 0 "
+      << std::fixed << t << " nohost " << t << std::defaultfloat << "\n";
+    scan.reset();
+    if (++written >= lines) break;
+  }
+  return out;
+}
+
+TEST(GraphSlamRegression, RobotLaserLogsWithoutOdomLinesScoreAsTheirFlaserLog) {
+  const int scans = 1500;
+  const std::string log = AcesAsRobotLaser(scans);
+  const std::string flaser = RunConfig(
+      "graph_slam.ini", "graph_slam_aces_flaser",
+      AcesSets({"pipeline.max_events=" + std::to_string(4 * scans), "slam.graph_background=false"}), "metrics.json");
+  const std::string robot = RunConfig("graph_slam.ini", "graph_slam_aces_robotlaser",
+                                      AcesSets({"source.path=" + log, "slam.graph_background=false"}), "metrics.json");
+  ASSERT_FALSE(flaser.empty());
+  ASSERT_FALSE(robot.empty());
+  EXPECT_EQ(Get(robot, {"scans"}), scans);
+  EXPECT_EQ(Get(robot, {"relations", "scored"}), Get(flaser, {"relations", "scored"}));
+  EXPECT_NEAR(Get(robot, {"relations", "translation_m", "mean"}), Get(flaser, {"relations", "translation_m", "mean"}),
+              5e-4);
+  // Naming an odometry channel the log does not have fails the run, and says what the log has.
+  try {
+    RunConfig("graph_slam.ini", "graph_slam_aces_wrong_odometry",
+              AcesSets({"source.path=" + log, "slam.odometry_channel=FLASER.odom"}), "metrics.json");
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("no scan was processed"), std::string::npos) << what;
+    EXPECT_NE(what.find("odometry_channel = FLASER.odom is not in the input, which has ROBOTLASER1.odom"),
+              std::string::npos)
+        << what;
+  }
+}
+
+TEST(GraphSlamFull, AcesEveryRelationBelowCartographer) {
+  const std::string j = RunConfig("graph_slam.ini", "graph_slam_aces_full", AcesSets(), "metrics.json");
+  ASSERT_FALSE(j.empty());
+  const double trans = Get(j, {"relations", "translation_m", "mean"});
+  const double rot = Get(j, {"relations", "rotation_deg", "mean"});
+  ::testing::Test::RecordProperty("translation_m", std::to_string(trans));
+  ::testing::Test::RecordProperty("rotation_deg", std::to_string(rot));
+  EXPECT_EQ(Get(j, {"relations", "scored"}), 1279);
+  EXPECT_LE(trans, kCartographerAcesM);
+  EXPECT_LE(rot, kCartographerAcesDeg);
+}
 
 }  // namespace
 }  // namespace mbot::app

@@ -63,9 +63,13 @@ class SlamStage : public Stage {
     Emit();
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
     if (session_->records().empty()) {
-      mbot::log::Warn("slam: no scan was processed (lidar channel '" + session_->inputs().lidar_channel() + "', " +
-                      std::to_string(session_->skipped_scans()) + " scans without poses); no outputs written");
-      return;
+      const std::string why = mapping::NoScanProcessedReason(*session_);
+      // A run stopped before its first scan has nothing to say; one that read its whole input failed.
+      if (interrupted) {
+        mbot::log::Warn("slam: " + why + "; no outputs written");
+        return;
+      }
+      throw std::runtime_error("slam: " + why);
     }
     WriteSlamOutputs(ctx, interrupted, options_, *session_, wall_s);
   }

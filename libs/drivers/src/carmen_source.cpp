@@ -137,7 +137,21 @@ CarmenSource::CarmenSource(const SourceOptions& options)
     diagnostics_.truncated_tail = true;
   }
   gzclose(f);
-  if (carmen_.file_order) {
+  bool file_order = carmen_.order == CarmenOptions::Order::kFile;
+  if (carmen_.order == CarmenOptions::Order::kAuto) {
+    int64_t latest = INT64_MIN, most_backwards = 0;
+    for (const Event& ev : events_) {
+      if (ev.stamp_us < latest) most_backwards = std::max(most_backwards, latest - ev.stamp_us);
+      latest = std::max(latest, ev.stamp_us);
+    }
+    file_order = most_backwards < static_cast<int64_t>(CarmenOptions::kAutoOrderJitterS * 1e6);
+    if (most_backwards > 0) {
+      mbot::log::Info(options.path + ": stamps run backwards by up to " + std::to_string(most_backwards * 1e-6) +
+                      " s: read in " + (file_order ? "file order (arrival-time jitter)" : "stamp order") +
+                      " (carmen_order = auto)");
+    }
+  }
+  if (file_order) {
     // File order: a record's event time is its stamp, or just after the record before when the stamp
     // runs backwards; the records of one line share it.
     int64_t last = INT64_MIN;
@@ -153,7 +167,7 @@ CarmenSource::CarmenSource(const SourceOptions& options)
     }
     if (backward_stamps_ > 0) {
       mbot::log::Info(options.path + ": " + std::to_string(backward_stamps_) +
-                      " records stamped before the record above them; kept in file order (carmen_order = file)");
+                      " records stamped before the record above them; kept in file order");
     }
   } else {
     std::stable_sort(events_.begin(), events_.end(), [](const Event& a, const Event& b) { return a.t_us < b.t_us; });
@@ -252,10 +266,11 @@ void CarmenSource::ParseLine(const std::string& line, int line_no) {
         c.Skip(5);  // tv rv forward_safety side_safety turn_axis
         ts = Micros(c.Num("timestamp"));
         c.End();
-        // Sensor offset on the robot, from the two poses the line gives.
+        // Sensor offset on the robot, from the two poses the line gives. In a raw log (the Freiburg
+        // hospital's, with no ODOM lines) the robot pose is the odometry at the scan.
         scan.sensor_pose = robot_pose.Inverse().Compose(laser);
-        events_.push_back(Event{ts, ts, name + ".pose", EventKind::kReferencePose, robot_pose});
-        channel(name + ".pose", "robot pose fields", EventKind::kReferencePose);
+        events_.push_back(Event{ts, ts, name + ".odom", EventKind::kOdometry, robot_pose});
+        channel(name + ".odom", "robot pose fields (odometry)", EventKind::kOdometry);
       } else {
         ts = Micros(c.Num("timestamp"));
         c.End();

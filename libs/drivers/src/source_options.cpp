@@ -70,9 +70,13 @@ void ParseCarmenOptions(config::Section& s, SourceOptions* out) {
   CarmenOptions o;
   o.max_range_m = s.GetDouble("carmen_max_range_m", o.max_range_m,
                               "CARMEN FLASER range limit when the log's PARAM lines do not give one [m]", 0.1, 1000.0);
-  o.file_order = s.GetChoice("carmen_order", "stamp", {"stamp", "file"},
-                             "CARMEN records in stamp order, or in file order with event times held "
-                             "non-decreasing (stamps that run backwards)") == "file";
+  o.order = s.GetEnum("carmen_order", CarmenOptions::Order::kAuto,
+                      {{"stamp", CarmenOptions::Order::kStamp},
+                       {"file", CarmenOptions::Order::kFile},
+                       {"auto", CarmenOptions::Order::kAuto}},
+                      "CARMEN records in stamp order, or in file order with event times held non-decreasing "
+                      "(stamps that run backwards); auto: file order when the stamps run backwards by less than "
+                      "2 s only (arrival times with jitter, as Intel's), else stamp order");
   out->extra = o;
 }
 

@@ -28,7 +28,9 @@ SlamSessionOptions ParseSlamSessionOptions(config::Section& s) {
   const std::string odo = s.GetChoice("odometry", "channel", {"channel", "encoders"},
                                       "odometry from an odometry channel or integrated from encoder ticks");
   o.encoder_odometry = odo == "encoders";
-  o.odometry_channel = s.GetString("odometry_channel", "", "odometry channel ('' = the first one seen)");
+  o.odometry_channel = s.GetString("odometry_channel", "",
+                                   "odometry channel ('' = the scan lines' own odometry fields, <lidar>.odom, when "
+                                   "the log has them, else the first one seen)");
   o.wheels = motion::ParseWheelConstants(s);  // used when odometry = encoders
   o.ground_truth_channel = s.GetString("ground_truth_channel", "", "ground-truth channel ('' = the first one seen)");
   o.reference_channel = s.GetString("reference_channel", "", "reference-pose channel ('' = the first one seen)");
@@ -123,6 +125,18 @@ bool SlamInputs::Add(const msgs::Event& in) {
   const msgs::Event& ev = Retime(in, &retimed);
   switch (ev.kind) {
     case EventKind::kOdometry:
+      ++odometry_seen_[ev.channel];
+      if (!o_.encoder_odometry && o_.odometry_channel.empty() && ScanLineOdometry(ev.channel)) {
+        // A CARMEN scan line's own odometry fields (FLASER, ROBOTLASER1) are the odometry at the
+        // scan itself; ODOM lines come in bursts. They win over an odometry channel taken earlier.
+        if (!odometry_channel_.empty() && odometry_channel_ != ev.channel) {
+          mbot::log::Info("slam: odometry from " + ev.channel + " (the scan lines' own fields), not " +
+                          odometry_channel_);
+          odometry_.clear();
+          continuity_ = motion::OdometryContinuity();
+        }
+        odometry_channel_ = ev.channel;
+      }
       if (!o_.encoder_odometry && Accept(&odometry_channel_, o_.odometry_channel, ev)) {
         AddOdometry(ev.t_us, std::get<Pose2D>(ev.payload));
       }
@@ -141,6 +155,7 @@ bool SlamInputs::Add(const msgs::Event& in) {
       return true;
     case EventKind::kLidar:
       if (Accept(&lidar_channel_, o_.lidar_channel, ev)) {
+        ++scans_seen_;
         // How late the scan arrived: its stamp is the robot's clock, its event time the logger's.
         const int64_t latency = std::llabs(in.t_us - in.stamp_us) < 2'000'000 ? in.t_us - in.stamp_us : 0;
         pending_.push_back(Scan{ev.t_us, previous_scan_us_, latency, in.stamp_us != 0 ? in.stamp_us : in.t_us,
@@ -192,6 +207,14 @@ const msgs::Event& SlamInputs::Retime(const msgs::Event& ev, msgs::Event* copy) 
   *copy = ev;
   copy->t_us = ev.stamp_us;
   return *copy;
+}
+
+// `<lidar>.odom`: the odometry fields of the chosen (or, before the first scan, any) lidar's lines.
+bool SlamInputs::ScanLineOdometry(const std::string& channel) const {
+  constexpr const char* kSuffix = ".odom";
+  if (channel.size() <= 5 || channel.compare(channel.size() - 5, 5, kSuffix) != 0) return false;
+  const std::string lidar = channel.substr(0, channel.size() - 5);
+  return lidar_channel_.empty() ? o_.lidar_channel.empty() || o_.lidar_channel == lidar : lidar_channel_ == lidar;
 }
 
 // Takes the first channel of a kind unless the options name one.
@@ -413,6 +436,35 @@ void SlamSession::Publish(const ScanRecord& r, std::vector<msgs::Event>* out) {
     out->push_back(msgs::Event{r.t_us, r.t_us, msgs::topics::kSlamMap, EventKind::kMap,
                                std::make_shared<const OccupancyGrid>(slam_.map())});
   }
+}
+
+std::string NoScanProcessedReason(const SlamSession& session) {
+  const SlamInputs& in = session.inputs();
+  const SlamSessionOptions& o = session.options();
+  if (in.scans_seen() == 0) {
+    return in.lidar_channel().empty() && o.lidar_channel.empty()
+               ? std::string("no scan was processed: the input has no lidar channel")
+               : "no scan was processed: no scan arrived on lidar channel '" +
+                     (o.lidar_channel.empty() ? in.lidar_channel() : o.lidar_channel) + "'";
+  }
+  std::string why = "no scan was processed: " + std::to_string(in.scans_seen()) + " scans on '" + in.lidar_channel() +
+                    "', " + std::to_string(session.skipped_scans()) + " of them without a pose";
+  if (o.slam.mode == SlamMode::kMappingOnly)
+    return why + " (mapping_only takes its poses from the " +
+           (o.mapping_poses_from_reference ? "reference" : "ground truth") + " channel)";
+  if (o.encoder_odometry) return why + " (odometry = encoders: no encoder ticks arrived)";
+  std::string seen;
+  for (const auto& [channel, n] : in.odometry_channels_seen()) {
+    seen += (seen.empty() ? "" : ", ") + channel + " (" + std::to_string(n) + ")";
+  }
+  const std::string wanted = o.odometry_channel.empty() ? in.odometry_channel() : o.odometry_channel;
+  if (seen.empty()) return why + ": the input has no odometry channel";
+  if (!wanted.empty() && !in.odometry_channels_seen().count(wanted)) {
+    return why + ": odometry_channel = " + wanted + " is not in the input, which has " + seen;
+  }
+  return why + ": odometry on " + wanted +
+         " did not cover the scans' times within max_pose_gap_s = " + std::to_string(o.max_pose_gap_s) +
+         " (odometry channels: " + seen + ")";
 }
 
 }  // namespace mbot::mapping

@@ -28,7 +28,10 @@ struct CarmenOptions {
   // CARMEN records in the order of their stamps (stamp), or in the file's order (file) for logs whose
   // stamps are arrival times that run backwards (the raw Intel log): each record's event time is then
   // its stamp held non-decreasing along the file, and its stamp is kept as the message's own.
-  bool file_order = false;
+  // Stamp order, file order (event times held non-decreasing), or auto: file order when the stamps
+  // run backwards by less than `kAutoOrderJitterS` only (arrival times with jitter), else stamp order.
+  enum class Order { kStamp, kFile, kAuto } order = Order::kAuto;
+  static constexpr double kAutoOrderJitterS = 2.0;
 };
 
 // Registers the dataset types (idempotent): astar_cases, movingai, map, rawlog, motor_csv, carmen, camera.

@@ -94,6 +94,10 @@ class SlamInputs {
   int64_t first_t_us() const { return first_t_us_; }
   int64_t last_t_us() const { return last_t_us_; }
   const std::string& lidar_channel() const { return lidar_channel_; }
+  const std::string& odometry_channel() const { return odometry_channel_; }
+  // Scans taken from the lidar channel, and every odometry channel seen (with its message count).
+  int64_t scans_seen() const { return scans_seen_; }
+  const std::map<std::string, int64_t>& odometry_channels_seen() const { return odometry_seen_; }
   int64_t kidnapped_at_us() const { return perturbation_.kidnapped_at_us(); }
   int odometry_restarts() const { return continuity_.restarts(); }
 
@@ -105,6 +109,7 @@ class SlamInputs {
  private:
   const msgs::Event& Retime(const msgs::Event& ev, msgs::Event* copy);
   bool Accept(std::string* chosen, const std::string& wanted, const msgs::Event& ev);
+  bool ScanLineOdometry(const std::string& channel) const;
   void AddOdometry(int64_t t_us, const motion::Pose2D& raw);
 
   const SlamSessionOptions& o_;
@@ -116,6 +121,8 @@ class SlamInputs {
   std::deque<Scan> pending_;
   std::map<std::string, bool> stamp_channels_;  // channel → its stamps share the log's clock
   int64_t previous_scan_us_ = -1;
+  int64_t scans_seen_ = 0;
+  std::map<std::string, int64_t> odometry_seen_;
   long long stamp_outliers_ = 0;  // stamps far from their arrival, placed at the arrival instead
   int64_t first_t_us_ = -1, last_t_us_ = -1;
 };
@@ -165,6 +172,7 @@ class SlamSession {
     on_checkpoint_ = std::move(write);
   }
 
+  const SlamSessionOptions& options() const { return o_; }
   const Slam& slam() const { return slam_; }
   const SlamInputs& inputs() const { return inputs_; }
   const std::vector<ScanRecord>& records() const { return records_; }
@@ -197,5 +205,9 @@ class SlamSession {
   std::function<void(const SlamCheckpointState&, const OccupancyGrid&)> on_checkpoint_;
   bool status_due_ = false, map_due_ = false;  // after a person's SlamControl
 };
+
+// Why a session processed no scan, in words that name the channels (the lidar's, the odometry's
+// and what the log had instead), for the error that ends such a run.
+std::string NoScanProcessedReason(const SlamSession& session);
 
 }  // namespace mbot::mapping
