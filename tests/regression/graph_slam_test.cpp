@@ -243,8 +243,8 @@ std::string AcesAsRobotLaser(int lines) {
     // As the reader places ACES's 180 FLASER beams (CARMEN's rule: 1° apart, centred).
     if (scan->ranges_m.size() != 180u) ADD_FAILURE() << "ACES scans have 180 beams";
     const double inc = M_PI / 180, start = -inc * 179 / 2;
-    o << "ROBOTLASER1 0 " << start << " " << inc * 179 << " " << inc << " "
-      << scan->max_range_m << " 0.01 0 " << scan->ranges_m.size();
+    o << "ROBOTLASER1 0 " << start << " " << inc * 179 << " " << inc << " " << scan->max_range_m << " 0.01 0 "
+      << scan->ranges_m.size();
     for (float r : scan->ranges_m) o << " " << r;
     const double t = ev->stamp_us * 1e-6;
     o << " 0 " << p.x << " " << p.y << " " << p.theta << " " << p.x << " " << p.y << " " << p.theta << " 0 0 0 0 0 "
