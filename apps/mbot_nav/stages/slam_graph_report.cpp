@@ -19,7 +19,9 @@ Json GraphSlamJson(const mapping::GraphSlamStats& g) {
   mbot::log::Info("slam: graph of " + std::to_string(g.nodes) + " nodes in " + std::to_string(g.submaps) +
                   " submaps; " + std::to_string(g.loop_closures) + " loop closures from " +
                   std::to_string(g.loop_searches) + " searches, " + std::to_string(g.rejected.size()) +
-                  " rejected by the robust loss; " + std::to_string(g.sparse_scans) + " scans too sparse to match");
+                  " rejected by the robust loss; " + std::to_string(g.sparse_scans) + " scans too sparse to match; " +
+                  std::to_string(g.recoveries) + " scans placed by a recovery search (of " +
+                  std::to_string(g.recovery_searches) + ")");
   for (size_t i = 0; i < g.rejected.size() && i < 5; ++i) {
     const mapping::RejectedClosure& r = g.rejected[i];
     mbot::log::Warn(
@@ -35,6 +37,8 @@ Json GraphSlamJson(const mapping::GraphSlamStats& g) {
   return {{"nodes", g.nodes},
           {"submaps", g.submaps},
           {"sparse_scans", g.sparse_scans},
+          {"recovery_searches", g.recovery_searches},
+          {"recoveries", g.recoveries},
           {"loop_searches", g.loop_searches},
           {"loop_closures", g.loop_closures},
           {"optimizations", g.optimizations},

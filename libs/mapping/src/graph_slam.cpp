@@ -73,12 +73,36 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
       // building the coarser ones on every insertion.
       s.field =
           std::make_shared<const MatchGrid>(s.grid->map(), options_.field_sigma_m, options_.occupied_threshold, 1);
+      s.wide.reset();
       s.dirty = false;
     }
     Pose2D start = local;
     if (options_.local_search) {
-      const MatchResult m = MatchBranchAndBound(*s.field, *points, local, options_.local_window, 0.0);
-      if (m.found) start = m.pose;
+      MatchResult m = MatchBranchAndBound(*s.field, *points, local, options_.local_window, 0.0);
+      if (options_.recover_below > 0 && scores_ >= 20 && (!m.found || m.score < options_.recover_below * mean_score_)) {
+        // The odometry's prior does not fit the map: look where the robot could be.
+        ++stats_.recovery_searches;
+        if (!s.wide) {
+          s.wide = std::make_shared<const MatchGrid>(
+              s.grid->map(), options_.field_sigma_m, options_.occupied_threshold,
+              LevelsFor(options_.recover_window.linear_m, options_.submap.resolution_m));
+        }
+        // Taken only where it fits as scans usually do: else the local answer stands.
+        const MatchResult w =
+            MatchBranchAndBound(*s.wide, *points, local, options_.recover_window,
+                                std::max(m.found ? m.score + 1e-6 : 0.0, options_.recover_below * mean_score_));
+        if (w.found) {
+          m = w;
+          ++stats_.recoveries;
+          odometry_doubtful_ = true;
+        }
+      }
+      if (m.found) {
+        start = m.pose;
+        // A slow running mean (about the last hundred scans).
+        mean_score_ = scores_ == 0 ? m.score : mean_score_ + (m.score - mean_score_) / std::min(scores_ + 1, 100);
+        ++scores_;
+      }
     }
     local = RefineMatch(*s.field, *points, start, options_.refine);
   }
@@ -143,13 +167,15 @@ void GraphSlam::AddNode(const Pose2D& local, const Pose2D& odometry, std::shared
     constraints_.push_back({PoseConstraint::kConsecutive, index - 1, index,
                             nodes_[index - 1].local.Inverse().Compose(local), options_.consecutive_translation_weight,
                             options_.consecutive_rotation_weight, 0.0});
-    if (options_.odometry_translation_weight > 0 || options_.odometry_rotation_weight > 0) {
+    // After a recovery the odometry between the two nodes is what was implausible: left out.
+    if ((options_.odometry_translation_weight > 0 || options_.odometry_rotation_weight > 0) && !odometry_doubtful_) {
       constraints_.push_back({PoseConstraint::kOdometry, index - 1, index,
                               nodes_[index - 1].odometry.Inverse().Compose(odometry),
                               options_.odometry_translation_weight, options_.odometry_rotation_weight, 0.0});
     }
   }
   nodes_.push_back(std::move(n));
+  odometry_doubtful_ = false;
   ++nodes_since_solve_;
   ++stats_.nodes;
   if (submaps_[active_.front()].nodes >= 2 * options_.nodes_per_submap) {
@@ -172,6 +198,7 @@ void GraphSlam::FinishSubmap(int index) {
       std::min(options_.loop_levels, LevelsFor(options_.loop_window.linear_m, options_.submap.resolution_m)));
   s.grid.reset();
   s.field.reset();
+  s.wide.reset();
   s.finished = true;
   s.dirty = false;
   // The nodes before it may see it too (the robot came back to where it is now).

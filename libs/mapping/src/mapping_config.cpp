@@ -163,6 +163,14 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
   g.local_window.linear_m = num("local_window_m", g.local_window.linear_m, "front end: search window, +-", 0.0, 10.0);
   g.local_window.angular_rad =
       num("local_window_rad", g.local_window.angular_rad, "front end: angular search window, +-", 0.0, M_PI);
+  g.recover_below = num("recover_below", g.recover_below,
+                        "front end: a fit below this share of the running mean score is searched again over the "
+                        "recovery window (0: never)",
+                        0.0, 1.0);
+  g.recover_window.linear_m =
+      num("recover_window_m", g.recover_window.linear_m, "front end: recovery search window, +-", 0.0, 20.0);
+  g.recover_window.angular_rad =
+      num("recover_window_rad", g.recover_window.angular_rad, "front end: recovery angular window, +-", 0.0, M_PI);
   g.refine.translation_weight =
       num("translation_weight", g.refine.translation_weight, "Ceres fit: pull towards the search's position", 0.0, 1e9);
   g.refine.rotation_weight =

@@ -92,6 +92,12 @@ SlamSessionOptions ParseSlamSessionOptions(config::Section& s) {
       s.GetDouble("kidnap_at_s", -1.0, "from this time on, odometry is offset by kidnap_offset (< 0: never)");
   const config::PoseValue k = s.GetPose("kidnap_offset", {1.0, 0.0, M_PI / 2}, "the kidnapping jump");
   pert.kidnap_offset = {k.x_m, k.y_m, k.theta_rad};
+  pert.jump_every_s = s.GetDouble("odometry_jump_every_s", 0.0,
+                                  "injected odometry glitches: a jump that stays, this often (0: never) [s]", 0.0);
+  pert.jump_max_m = s.GetDouble("odometry_jump_max_m", 1.0, "... of up to this length, in a random direction", 0.0);
+  pert.jump_max_rad = s.GetDouble("odometry_jump_max_rad", 0.0, "... and up to this turn, either way", 0.0, M_PI);
+  o.scan_every = static_cast<int>(s.GetInt(
+      "scan_every", 1, "use every k-th scan of the lidar channel (others dropped: robustness tests)", 1, 1000));
 
   o.particles_every = static_cast<int>(
       s.GetInt("particles_every", o.particles_every, "draw the particles every k-th scan (0: never)", 0));
@@ -155,7 +161,7 @@ bool SlamInputs::Add(const msgs::Event& in) {
       return true;
     case EventKind::kLidar:
       if (Accept(&lidar_channel_, o_.lidar_channel, ev)) {
-        ++scans_seen_;
+        if (scans_seen_++ % o_.scan_every != 0) return true;
         // How late the scan arrived: its stamp is the robot's clock, its event time the logger's.
         const int64_t latency = std::llabs(in.t_us - in.stamp_us) < 2'000'000 ? in.t_us - in.stamp_us : 0;
         pending_.push_back(Scan{ev.t_us, previous_scan_us_, latency, in.stamp_us != 0 ? in.stamp_us : in.t_us,

@@ -22,6 +22,19 @@ Pose2D OdometryPerturbation::Apply(int64_t t_us, int64_t start_us, const Pose2D&
   }
   first_ = false;
   last_raw_ = raw;
+  if (o_.jump_every_s > 0 && start_us >= 0) {
+    const int due = static_cast<int>((t_us - start_us) / (o_.jump_every_s * 1e6));
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (; jumps_ < due; ++jumps_) {
+      const double length = o_.jump_max_m * u(rng_), direction = 2 * M_PI * u(rng_);
+      const Pose2D jump{length * std::cos(direction), length * std::sin(direction),
+                        o_.jump_max_rad * (2 * u(rng_) - 1)};
+      // Moved by `jump` and turned about where the odometry has the robot now.
+      const Pose2D at = jumped_.Compose(out);
+      jumped_ = Pose2D{at.x + jump.x, at.y + jump.y, jump.theta}.Compose(Pose2D{-at.x, -at.y, 0}).Compose(jumped_);
+    }
+    out = jumped_.Compose(out);
+  }
   if (o_.kidnap_at_s >= 0 && start_us >= 0 && t_us - start_us >= o_.kidnap_at_s * 1e6) {
     if (kidnap_us_ < 0) kidnap_us_ = t_us;
     out = o_.kidnap_offset.Compose(out);

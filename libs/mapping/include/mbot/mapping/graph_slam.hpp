@@ -40,6 +40,12 @@ struct GraphSlamOptions {
   bool local_search = true;  // correlative search before the Ceres fit
   SearchWindow local_window{0.1, 0.2, 0.005};
   RefineOptions refine;
+  // Recovery from an implausible odometry prior (a glitch, a gap, a zeroed jump): a scan whose best
+  // fit in the local window scores below `recover_below` × the running mean score is searched again
+  // over `recover_window`; a pose found there that scores above that bound and better than the
+  // local one is kept, and the odometry constraint to the next node is then left out (0: never).
+  double recover_below = 0.75;
+  SearchWindow recover_window{1.5, 0.5, 0.005};
   // A scan becomes a node when it moved this far from the last node (or turned this much).
   double node_distance_m = 0.1;
   double node_angle_rad = 0.0175;
@@ -69,6 +75,7 @@ struct RejectedClosure {
 
 struct GraphSlamStats {
   int scans = 0, nodes = 0, submaps = 0, sparse_scans = 0;
+  int recovery_searches = 0, recoveries = 0;  // wide searches made, and those that moved the scan
   int64_t loop_searches = 0, loop_closures = 0;
   std::vector<RejectedClosure> rejected;  // by the robust loss, at the last solve
   int optimizations = 0;
@@ -126,6 +133,7 @@ class GraphSlam {
     motion::Pose2D local, global;            // local: a translation (the grid is axis-aligned in the local frame)
     std::unique_ptr<LogOddsMapper> grid;     // while active
     std::shared_ptr<const MatchGrid> field;  // the front end's (while active)
+    std::shared_ptr<const MatchGrid> wide;   // ... with levels for a recovery search (built on demand)
     std::shared_ptr<const LoopField> loop;   // the loop-closure search's (once finished)
     bool dirty = true;
     bool finished = false;
@@ -178,6 +186,9 @@ class GraphSlam {
   bool initialized_ = false;
   motion::Pose2D last_odometry_, last_local_;
   motion::Pose2D correction_;  // global ⊕ local⁻¹, from the last solve
+  double mean_score_ = 0;      // running mean of the front end's match scores
+  int scores_ = 0;
+  bool odometry_doubtful_ = false;  // a recovery since the last node
   std::vector<Node> nodes_;
   std::vector<Submap> submaps_;
   std::vector<int> active_;  // submap indices, oldest first

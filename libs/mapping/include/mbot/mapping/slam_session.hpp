@@ -53,6 +53,7 @@ struct SlamSessionOptions {
   double checkpoint_every_s = 0.0;                // 0: no checkpoints
   // Perturbations for robustness tests.
   motion::OdometryPerturbationOptions perturbation;
+  int scan_every = 1;  // use every k-th scan (robustness tests drop the others)
   // What is published, and kept for pictures.
   int particles_every = 0;          // keep the particles every k-th scan, for the map picture (0: never)
   int publish_particles_every = 0;  // emit SLAM_PARTICLES every k-th scan (0: never)
