@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <string_view>
 
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
@@ -217,9 +218,10 @@ const msgs::Event& SlamInputs::Retime(const msgs::Event& ev, msgs::Event* copy) 
 
 // `<lidar>.odom`: the odometry fields of the chosen (or, before the first scan, any) lidar's lines.
 bool SlamInputs::ScanLineOdometry(const std::string& channel) const {
-  constexpr const char* kSuffix = ".odom";
-  if (channel.size() <= 5 || channel.compare(channel.size() - 5, 5, kSuffix) != 0) return false;
-  const std::string lidar = channel.substr(0, channel.size() - 5);
+  const std::string_view suffix = ".odom";
+  if (channel.size() <= suffix.size() || channel.compare(channel.size() - suffix.size(), suffix.size(), suffix) != 0)
+    return false;
+  const std::string lidar = channel.substr(0, channel.size() - suffix.size());
   return lidar_channel_.empty() ? o_.lidar_channel.empty() || o_.lidar_channel == lidar : lidar_channel_ == lidar;
 }
 

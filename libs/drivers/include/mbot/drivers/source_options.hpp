@@ -27,9 +27,8 @@ struct CarmenOptions {
   double max_range_m = 81.0;
   // CARMEN records in the order of their stamps (stamp), or in the file's order (file) for logs whose
   // stamps are arrival times that run backwards (the raw Intel log): each record's event time is then
-  // its stamp held non-decreasing along the file, and its stamp is kept as the message's own.
-  // Stamp order, file order (event times held non-decreasing), or auto: file order when the stamps
-  // run backwards by less than `kAutoOrderJitterS` only (arrival times with jitter), else stamp order.
+  // its stamp held non-decreasing along the file, and its stamp is kept as the message's own. auto:
+  // file order when the stamps run backwards by less than `kAutoOrderJitterS` only, else stamp order.
   enum class Order { kStamp, kFile, kAuto } order = Order::kAuto;
   static constexpr double kAutoOrderJitterS = 2.0;
 };
