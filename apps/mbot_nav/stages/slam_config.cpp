@@ -47,6 +47,15 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
                   0.0) *
       1e6);
   o.map_basename = s.GetString("map_basename", o.map_basename, "map files in output.dir: .map, .pgm/.yaml, .png, .bt");
+  o.map_resolution_m = s.GetDouble("map_resolution_m", 0.0,
+                                   "the written map's cell size: graph SLAM renders every scan again at its optimised "
+                                   "pose at this resolution after the run (0: the SLAM's own resolution_m)",
+                                   0.0, 10.0);
+  if (o.map_resolution_m > 0 && m.mode != mapping::SlamMode::kGraphSlam && !s.describing())
+    s.Fail("map_resolution_m", "needs mode = graph_slam (the other modes keep no scans to render again)");
+  o.graph_file = s.GetString("graph_file", o.graph_file,
+                             "graph SLAM: the pose graph in g2o's text format (VERTEX_SE2 / EDGE_SE2), in the output "
+                             "folder (empty: none)");
   o.png_scale = static_cast<int>(s.GetInt("png_scale", o.png_scale, "pixels per map cell in the PNG", 1, 16));
   o.octomap_height_m =
       s.GetDouble("octomap_height_m", o.octomap_height_m, "wall height in the OctoMap .bt (0: none)", 0.0);

@@ -25,9 +25,11 @@ struct SlamStageOptions {
   int64_t score_max_latency_us = 0;  // ... that arrived at most this late (0: all)
   std::string map_basename = "slam_map";
   int png_scale = 2;
-  double octomap_height_m = 0.3;  // wall height in the OctoMap (0: no .bt)
-  bool tum_stamps = false;        // the TUM files and the relations use the scans' own stamps
-  std::string relations_file;     // a .relations file to score the trajectory on ("" = none)
+  double map_resolution_m = 0;                // the written map's resolution (0: the SLAM's own; graph SLAM only)
+  std::string graph_file = "slam_graph.g2o";  // graph SLAM's pose graph, in g2o's format ("" = none)
+  double octomap_height_m = 0.3;              // wall height in the OctoMap (0: no .bt)
+  bool tum_stamps = false;                    // the TUM files and the relations use the scans' own stamps
+  std::string relations_file;                 // a .relations file to score the trajectory on ("" = none)
 };
 
 SlamStageOptions ParseSlamStageOptions(config::Section& s);

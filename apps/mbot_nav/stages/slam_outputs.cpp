@@ -2,11 +2,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/drivers/map_io.hpp"
+#include "mbot/mapping/pose_graph_io.hpp"
 #include "mbot/motion/trajectory_error.hpp"
 #include "report.hpp"
 #include "slam_graph_report.hpp"
@@ -88,8 +90,12 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamStageOp
   WriteScansCsv(dir + "slam_scans.csv", records);
   if (!truth_path.empty()) WriteTum(dir + "ground_truth.tum", truth_name + " at the scan times", truth_path);
 
-  const mapping::OccupancyGrid& map = session.slam().map();
+  const mapping::GraphSlam* graph = session.slam().graph();
+  std::optional<mapping::OccupancyGrid> rendered;
+  if (graph && options.map_resolution_m > 0) rendered = graph->RenderMap(options.map_resolution_m);
+  const mapping::OccupancyGrid& map = rendered ? *rendered : session.slam().map();
   const std::string base = dir + options.map_basename;
+  if (graph && !options.graph_file.empty()) mapping::WriteG2o(graph->Graph(), dir + options.graph_file);
   if (session.slam().BuildsMap()) {
     drivers::WriteBotlabMap(map, base + ".map");
     drivers::WriteRosMap(map, base + ".yaml");
@@ -146,7 +152,10 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamStageOp
                     Num(a.theta.rmse * 180 / M_PI, 3) + " deg; odometry xy " + Num(o.xy.rmse, 3) + " m, theta " +
                     Num(o.theta.rmse * 180 / M_PI, 3) + " deg");
   }
-  if (const mapping::GraphSlam* g = session.slam().graph()) j["graph"] = GraphSlamJson(g->stats());
+  if (graph) {
+    j["graph"] = GraphSlamJson(graph->stats());
+    if (!options.graph_file.empty()) j["graph"]["g2o"] = options.graph_file;
+  }
   // A relations file that does not fit the run is an error, but only once everything else is written.
   std::string relations_error;
   if (!options.relations_file.empty())

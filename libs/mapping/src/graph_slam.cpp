@@ -343,6 +343,21 @@ void GraphSlam::InsertScans(const std::vector<ScanAnchor>& scans, size_t from, c
     map->Insert(*scans[i].rays, nodes[scans[i].node].Compose(scans[i].relative));
 }
 
+OccupancyGrid GraphSlam::RenderMap(double resolution_m) const {
+  if (!(resolution_m > 0)) throw std::invalid_argument("graph SLAM: the map's resolution must be positive");
+  MapperOptions o = map_options_;
+  o.resolution_m = resolution_m;
+  LogOddsMapper map(o);
+  InsertScans(scans_, 0, NodePoses(), &map);
+  return map.map();
+}
+
+G2oGraph GraphSlam::Graph() const {
+  std::vector<Pose2D> submaps;
+  for (const Submap& s : submaps_) submaps.push_back(s.global);
+  return ToG2o(NodePoses(), submaps, constraints_);
+}
+
 std::vector<Pose2D> GraphSlam::NodePoses() const {
   std::vector<Pose2D> out;
   out.reserve(nodes_.size());

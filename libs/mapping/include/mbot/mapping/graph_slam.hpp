@@ -22,6 +22,7 @@
 #include "mbot/mapping/log_odds_mapper.hpp"
 #include "mbot/mapping/moving_scan.hpp"
 #include "mbot/mapping/pose_graph.hpp"
+#include "mbot/mapping/pose_graph_io.hpp"
 #include "mbot/mapping/scan_matching.hpp"
 #include "mbot/motion/pose2d.hpp"
 
@@ -103,6 +104,10 @@ class GraphSlam {
   // Every scan's pose so far (one per ProcessScan call), from the optimised nodes.
   std::vector<motion::Pose2D> Trajectory() const;
   const OccupancyGrid& map() const { return map_.map(); }
+  // The map rendered again from every scan at its optimised pose, at another resolution.
+  OccupancyGrid RenderMap(double resolution_m) const;
+  // The pose graph as it stands (after Finish: the final solve's), in the g2o layout of ToG2o.
+  G2oGraph Graph() const;
   const GraphSlamStats& stats() const { return stats_; }
   const GraphSlamOptions& options() const { return options_; }
 
