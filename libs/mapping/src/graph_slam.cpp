@@ -104,7 +104,20 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
         ++scores_;
       }
     }
+    const Pose2D predicted = local;
     local = RefineMatch(*s.field, *points, start, options_.refine);
+    if (options_.front_min_constraint_ratio > 0) {
+      // Where the scan cannot tell how far it moved (a corridor), the match's answer along the
+      // corridor is the map's edge, not the motion: odometry's prediction stands there.
+      const TranslationConstraint tc = ScanTranslationConstraint(*points, local.theta);
+      if (tc.ratio() < options_.front_min_constraint_ratio) {
+        const double ux = std::cos(tc.weak_axis_rad), uy = std::sin(tc.weak_axis_rad);
+        const double along = (local.x - predicted.x) * ux + (local.y - predicted.y) * uy;
+        local.x -= along * ux;
+        local.y -= along * uy;
+        ++stats_.degenerate_scans;
+      }
+    }
   }
   last_local_ = local;
   last_odometry_ = odometry;

@@ -171,6 +171,11 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
       num("recover_window_m", g.recover_window.linear_m, "front end: recovery search window, +-", 0.0, 20.0);
   g.recover_window.angular_rad =
       num("recover_window_rad", g.recover_window.angular_rad, "front end: recovery angular window, +-", 0.0, M_PI);
+  g.front_min_constraint_ratio =
+      num("front_min_constraint_ratio", g.front_min_constraint_ratio,
+          "front end: a scan whose surfaces pin its position down along one direction only (weakest over strongest "
+          "information below this: a corridor) keeps odometry's motion along it (0: trust the fit)",
+          0.0, 1.0);
   g.refine.translation_weight =
       num("translation_weight", g.refine.translation_weight, "Ceres fit: pull towards the search's position", 0.0, 1e9);
   g.refine.rotation_weight =

@@ -3,6 +3,8 @@
 #include <ceres/ceres.h>
 #include <ceres/cubic_interpolation.h>
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -99,6 +101,41 @@ double MatchGrid::Score(const motion::Pose2D& pose, const std::vector<Point2>& p
               static_cast<int>(std::floor((y - origin_y_) / resolution_)));
   }
   return sum / points.size();
+}
+
+TranslationConstraint ScanTranslationConstraint(const std::vector<Point2>& points, double theta) {
+  TranslationConstraint out;
+  Eigen::Matrix2d h = Eigen::Matrix2d::Zero();
+  int used = 0;
+  // Each point's normal: the direction of least spread of its neighbours along the scan within
+  // kRadius (up to kReach points either way), so that range noise does not tilt it.
+  constexpr double kRadius = 0.25;
+  constexpr int kReach = 6, kMinNeighbours = 3;
+  const int n = static_cast<int>(points.size());
+  for (int i = 0; i < n; ++i) {
+    const Point2& p = points[i];
+    double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+    int count = 0;
+    for (int j = std::max(0, i - kReach); j <= std::min(n - 1, i + kReach); ++j) {
+      const double dx = points[j].x - p.x, dy = points[j].y - p.y;
+      if (dx * dx + dy * dy > kRadius * kRadius) continue;
+      sx += dx, sy += dy, sxx += dx * dx, sxy += dx * dy, syy += dy * dy;
+      ++count;
+    }
+    if (count < kMinNeighbours) continue;  // an isolated return: no surface to take a direction from
+    Eigen::Matrix2d c;
+    c << sxx - sx * sx / count, sxy - sx * sy / count, sxy - sx * sy / count, syy - sy * sy / count;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> local(c);
+    const Eigen::Vector2d normal = local.eigenvectors().col(0);
+    h += normal * normal.transpose();
+    ++used;
+  }
+  if (used < 2) return out;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(h / used);
+  out.weak = eig.eigenvalues()[0];
+  out.strong = eig.eigenvalues()[1];
+  out.weak_axis_rad = motion::WrapAngle(theta + std::atan2(eig.eigenvectors()(1, 0), eig.eigenvectors()(0, 0)));
+  return out;
 }
 
 size_t MatchGrid::bytes() const {

@@ -46,6 +46,10 @@ struct GraphSlamOptions {
   // over `recover_window`; a pose found there that scores above that bound and better than the
   // local one is kept, and the odometry constraint to the next node is then left out (0: never).
   double recover_below = 0.75;
+  // A scan that cannot pin its position down along a direction (its surfaces' weakest information
+  // below this share of their strongest, ScanTranslationConstraint: a corridor) keeps odometry's
+  // motion along it; the fit would put it where the submap's walls end (0: trust the fit).
+  double front_min_constraint_ratio = 0.003;
   SearchWindow recover_window{1.5, 0.5, 0.005};
   // A scan becomes a node when it moved this far from the last node (or turned this much).
   double node_distance_m = 0.1;
@@ -76,7 +80,9 @@ struct RejectedClosure {
 
 struct GraphSlamStats {
   int scans = 0, nodes = 0, submaps = 0, sparse_scans = 0;
-  int recovery_searches = 0, recoveries = 0;  // wide searches made, and those that moved the scan
+  int recovery_searches = 0, recoveries = 0;
+  int degenerate_scans =
+      0;  // whose motion along a corridor came from odometry  // wide searches made, and those that moved the scan
   int64_t loop_searches = 0, loop_closures = 0;
   std::vector<RejectedClosure> rejected;  // by the robust loss, at the last solve
   int optimizations = 0;

@@ -11,6 +11,7 @@
 // Scores are the mean field value over the scan's points, in [0, 1].
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -85,6 +86,19 @@ struct MatchResult {
 // `min_score`; found = false when none does.
 MatchResult MatchBranchAndBound(const MatchGrid& grid, const std::vector<Point2>& points, const motion::Pose2D& initial,
                                 const SearchWindow& window, double min_score);
+
+// How firmly a scan can pin its own position down, from its geometry alone: the information of its
+// surfaces, Σ n nᵀ over the points' normals (from their neighbours along the scan), per point. A
+// room's scan faces every way (weak ≈ strong); a corridor's faces across it only (weak ≈ 0), so a
+// match of it says nothing about the position along the corridor — whatever a submap's wall ends
+// or its gaps between sparse far returns suggest. The weak axis is turned by `theta` (the scan's
+// heading) into the map's frame.
+struct TranslationConstraint {
+  double strong = 0, weak = 0;  // the eigenvalues of the mean n nᵀ: strong + weak = 1
+  double weak_axis_rad = 0;     // the direction the scan can slide along
+  double ratio() const { return strong > 0 ? std::max(weak, 0.0) / strong : 0.0; }
+};
+TranslationConstraint ScanTranslationConstraint(const std::vector<Point2>& points, double theta);
 
 struct RefineOptions {
   double occupied_weight = 1.0;     // of the field term (summed over points, scaled by 1/√n)
