@@ -372,5 +372,19 @@ TEST(ScanTranslationConstraint, TellsACorridorFromARoom) {
       ScanTranslationConstraint(ScanHitPoints(ScanWithin(world, {5.0, 3.0, 0.0}, 6.0, &rng)), 0.0);
   EXPECT_GT(door.ratio(), 0.01);
 }
+// The whole-map search: a scan from anywhere in the building, at any heading, is found where it was
+// taken; a scan of another place is not found.
+TEST(GlobalMatch, FindsAScanAnywhereOnTheMap) {
+  const OccupancyGrid world = Building();
+  for (const Pose2D& truth : {Pose2D{2.0, 6.5, 2.5}, Pose2D{10.3, 1.5, -1.0}, Pose2D{7.0, 2.2, 0.1}}) {
+    const MatchResult m = GlobalMatch(world, ScanHitPoints(ScanAt(world, truth), 0.1), 0.05, 0, 0.6);
+    ASSERT_TRUE(m.found);
+    EXPECT_LT(std::hypot(m.pose.x - truth.x, m.pose.y - truth.y), 0.05);
+    EXPECT_LT(std::abs(motion::WrapAngle(m.pose.theta - truth.theta)), 0.02);
+  }
+  const Room room;  // 4 m square, nothing like the building's 12 x 8 m floor
+  EXPECT_FALSE(GlobalMatch(world, ScanHitPoints(room.rays, 0.1), 0.05, 0, 0.8).found);
+}
+
 }  // namespace
 }  // namespace mbot::mapping

@@ -91,6 +91,64 @@ TEST(GraphSlamRegression, WritesTheGraphAsG2oAndTheMapAtAnyResolution) {
   EXPECT_GT(Get(j, {"map", "width"}), 800);
 }
 
+// A session that starts on a finished map: the first 8,000 events of Intel map the building; a
+// second run starts 5,000 events into the log with no pose (initial_pose = global), finds its first
+// scan on that map by a whole-map search and tracks on. Both runs' poses agree at the same stamps.
+// A map of another place is an error naming the map.
+std::map<std::string, std::pair<double, double>> TumXy(const std::string& path) {
+  std::map<std::string, std::pair<double, double>> out;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream s(line);
+    std::string t;
+    double x, y;
+    if (s >> t >> x >> y) out[t] = {x, y};
+  }
+  return out;
+}
+
+TEST(GraphSlamRegression, AResumedSessionFindsItselfOnAFinishedMap) {
+  ASSERT_FALSE(RunConfig("graph_slam.ini", "graph_slam_map_first",
+                         {"pipeline.max_events=8000", "slam.graph_background=false"}, "metrics.json")
+                   .empty());
+  const std::string map = ::testing::TempDir() + "/graph_slam_map_first/slam_map.yaml";
+  ASSERT_FALSE(RunConfig("graph_slam.ini", "graph_slam_map_global",
+                         {"pipeline.skip_events=5000", "pipeline.max_events=1500", "slam.graph_background=false",
+                          "slam.initial_pose=global", "slam.map_file=" + map, "--unset slam.relations"},
+                         "metrics.json")
+                   .empty());
+  const auto first = TumXy(::testing::TempDir() + "/graph_slam_map_first/slam.tum");
+  const auto second = TumXy(::testing::TempDir() + "/graph_slam_map_global/slam.tum");
+  ASSERT_GT(second.size(), 200u);
+  const auto& [t0, p0] = *second.begin();
+  ASSERT_TRUE(first.count(t0)) << t0;
+  EXPECT_LT(std::hypot(p0.first - first.at(t0).first, p0.second - first.at(t0).second), 0.05);  // 1 cm measured
+  double worst = 0;
+  int both = 0;
+  for (const auto& [t, p] : second) {
+    if (!first.count(t)) continue;
+    ++both;
+    worst = std::max(worst, std::hypot(p.first - first.at(t).first, p.second - first.at(t).second));
+  }
+  EXPECT_GT(both, 200);
+  EXPECT_LT(worst, 0.15);
+  ::testing::Test::RecordProperty("worst_against_first_run_m", std::to_string(worst));
+
+  try {
+    RunConfig("graph_slam.ini", "graph_slam_map_wrong",
+              {"pipeline.skip_events=5000", "pipeline.max_events=200", "slam.graph_background=false",
+               "slam.initial_pose=global", "slam.map_file=" + Data("botlab/astar/empty.map"), "--unset slam.relations"},
+              "metrics.json");
+    FAIL() << "no error";
+  } catch (const std::exception& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("whole-map search found no pose"), std::string::npos) << what;
+    EXPECT_NE(what.find("empty.map"), std::string::npos) << what;
+  }
+}
+
 TEST(GraphSlamRegression, RelationsThatMatchNoScanAreAnErrorNamingTheFileAndStamp) {
   // FR079's relations use log-relative stamps (1215 s …): none falls within the Intel log.
   try {

@@ -11,10 +11,19 @@ SlamStageOptions ParseSlamStageOptions(config::Section& s) {
   SlamStageOptions o;
   o.session = mapping::ParseSlamSessionOptions(s);
   const mapping::SlamOptions& m = o.session.slam;
-  o.map_file = s.GetPath("map_file", "", "localization: the known map (any format the map reader knows)");
+  o.map_file = s.GetPath("map_file", "",
+                         "localization: the known map; graph_slam with initial_pose = global: the finished map the "
+                         "first scan is found on by a whole-map search (any format the map reader knows)");
   if (m.mode == mapping::SlamMode::kLocalization && o.map_file.empty() && !s.describing()) {
     s.Fail("map_file", "localization mode needs a map_file");
   }
+  if (m.mode == mapping::SlamMode::kGraphSlam && !s.describing()) {
+    if (o.session.initial == "global" && o.map_file.empty())
+      s.Fail("initial_pose", "global in graph_slam mode needs a map_file to search");
+    if (o.session.initial != "global" && !o.map_file.empty())
+      s.Fail("map_file", "graph_slam reads a map_file only with initial_pose = global (the map to start on)");
+  }
+  o.session.known_map_name = o.map_file;
   o.truth_is_reference = s.GetChoice("truth", "ground_truth", {"ground_truth", "reference"},
                                      "what metrics.json scores against") == "reference";
   o.checkpoint_file = s.GetString("checkpoint_file", "slam_checkpoint.ini",

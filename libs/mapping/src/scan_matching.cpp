@@ -138,6 +138,25 @@ TranslationConstraint ScanTranslationConstraint(const std::vector<Point2>& point
   return out;
 }
 
+MatchResult GlobalMatch(const OccupancyGrid& map, const std::vector<Point2>& points, double sigma_m,
+                        int occupied_threshold, double min_score, double min_angular_step_rad) {
+  MatchResult best;
+  if (points.empty() || map.width() == 0) return best;
+  const double half_w = 0.5 * map.width() * map.resolution(), half_h = 0.5 * map.height() * map.resolution();
+  const double linear = std::max(half_w, half_h);
+  int levels = 1;
+  while ((1 << (levels - 1)) < 2 * static_cast<int>(std::ceil(linear / map.resolution())) + 1 && levels < 12) ++levels;
+  const MatchGrid grid(map, sigma_m, occupied_threshold, levels);
+  const motion::Pose2D centre{map.origin_x() + half_w, map.origin_y() + half_h, 0.0};
+  best = MatchBranchAndBound(grid, points, centre, SearchWindow{linear, M_PI, min_angular_step_rad}, min_score);
+  if (best.found) {
+    best.pose = RefineMatch(grid, points, best.pose, RefineOptions{});
+    best.pose.theta = motion::WrapAngle(best.pose.theta);
+    best.score = grid.Score(best.pose, points);
+  }
+  return best;
+}
+
 size_t MatchGrid::bytes() const {
   size_t b = 0;
   for (const auto& l : levels_) b += l.size();

@@ -4,11 +4,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <stdexcept>
 #include <string_view>
 
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
 #include "mbot/common/process.hpp"
+#include "mbot/common/strings.hpp"
 #include "mbot/mapping/mapping_config.hpp"
 #include "mbot/motion/motion_config.hpp"
 #include "mbot/msgs/topics.hpp"
@@ -73,8 +75,8 @@ SlamSessionOptions ParseSlamSessionOptions(config::Section& s) {
     const config::PoseValue p = s.GetPose("initial_pose", {}, "start pose");
     o.initial_pose = {p.x_m, p.y_m, p.theta_rad};
   }
-  if (o.initial == "global" && m.mode != SlamMode::kLocalization && !s.describing()) {
-    s.Fail("initial_pose", "global needs mode = localization");
+  if (o.initial == "global" && m.mode != SlamMode::kLocalization && m.mode != SlamMode::kGraphSlam && !s.describing()) {
+    s.Fail("initial_pose", "global needs mode = localization or graph_slam (and a map_file)");
   }
   o.initial_sigma_xy = s.GetDouble("initial_sigma_xy_m", 0.0, "spread of the first particles around the start", 0.0);
   o.initial_sigma_theta = s.GetDouble("initial_sigma_theta_rad", 0.0, "heading spread of the first particles", 0.0);
@@ -271,7 +273,11 @@ SlamSession::SlamSession(const SlamSessionOptions& options, uint64_t seed, std::
       inputs_(options, seed),
       events_(options.slam.filter.lost_inlier_fraction),
       consistency_model_(options.slam.sensor) {
-  if (known_map) slam_.SetMap(std::move(*known_map));
+  if (known_map && options.slam.mode == SlamMode::kGraphSlam) {
+    global_map_ = std::move(known_map);
+  } else if (known_map) {
+    slam_.SetMap(std::move(*known_map));
+  }
 }
 
 void SlamSession::Add(const msgs::Event& event, std::vector<msgs::Event>* out) {
@@ -336,7 +342,7 @@ void SlamSession::ProcessScan(const SlamInputs::Scan& p, int64_t t_end, std::vec
   const std::vector<ScanRay> rays =
       DeskewScan(scan.ranges_m, scan.angles_rad, fractions, end_pose.Inverse().Compose(start_pose), sensor,
                  scan.max_range_m, o_.scan);
-  if (!slam_.initialized() && !Initialize(t_end, end_pose)) {
+  if (!slam_.initialized() && !Initialize(t_end, end_pose, rays)) {
     ++skipped_scans_;
     return;
   }
@@ -392,9 +398,29 @@ void SlamSession::PairRecordsAndTrim(int64_t scan_start_us, int64_t max_gap_us) 
   inputs_.TrimBefore(std::min(waiting, scan_start_us) - 2 * max_gap_us);
 }
 
-bool SlamSession::Initialize(int64_t t_us, const Pose2D& odometry) {
+bool SlamSession::Initialize(int64_t t_us, const Pose2D& odometry, const std::vector<ScanRay>& rays) {
   const int64_t max_gap = static_cast<int64_t>(o_.max_pose_gap_s * 1e6);
   Pose2D start = o_.initial_pose;
+  if (o_.initial == "global" && o_.slam.mode == SlamMode::kGraphSlam) {
+    if (!global_map_) throw std::invalid_argument("slam: initial_pose = global needs a map to search (map_file)");
+    const GraphSlamOptions& g = o_.slam.graph;
+    const std::vector<Point2> points = ScanHitPoints(rays, g.loop_point_spacing_m);
+    if (static_cast<int>(points.size()) < g.min_points) return false;  // too sparse: the next scan
+    const auto w0 = std::chrono::steady_clock::now();
+    const MatchResult m = GlobalMatch(*global_map_, points, g.field_sigma_m, 0, g.loop_min_score);
+    const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+    if (!m.found) {
+      throw std::runtime_error(
+          "slam: the whole-map search found no pose where the first scan (" + std::to_string(points.size()) +
+          " returns) scores graph_loop_min_score = " + Significant(g.loop_min_score, 3) + " on " + o_.known_map_name);
+    }
+    mbot::log::Info("slam: found on the map by a whole-map search at (" + Significant(m.pose.x, 4) + ", " +
+                    Significant(m.pose.y, 4) + ", " + Significant(m.pose.theta * 180 / M_PI, 4) + " deg), score " +
+                    Significant(m.score, 3) + ", in " + Significant(wall_s, 3) + " s");
+    global_map_.reset();
+    slam_.Initialize(m.pose, odometry, 0, 0);
+    return true;
+  }
   if (o_.initial == "global") {
     slam_.InitializeGlobal(odometry);
     events_.GlobalStarted();

@@ -168,6 +168,10 @@ PipelinePlan BuildPlan(const config::Config& config) {
     plan.pipeline.progress = s.GetChoice("progress", "auto", {"auto", "bar", "lines", "off"},
                                          "progress display: a bar on a terminal, a line every 10% otherwise");
     plan.pipeline.max_events = s.GetInt("max_events", 0, "stop after this many events (0: the whole input)", 0);
+    plan.pipeline.skip_events = s.GetInt("skip_events", 0,
+                                         "read and drop the input's first events (a replay that starts later in a "
+                                         "log; max_events counts after them)",
+                                         0);
     plan.pipeline.playback_speed =
         s.GetDouble("playback_speed", 0.0,
                     "a recording plays this many times real time (0: as fast as it can; a viewer can pause it and "
@@ -285,6 +289,9 @@ RunSummary RunPlan(PipelinePlan& plan, const std::atomic<bool>& stop) {
     for (auto& [name, stage] : plan.stages) stage->OnEvent(e);
   };
   try {
+    for (long long i = 0; i < plan.pipeline.skip_events && !stop.load(); ++i) {
+      if (!source->Next()) break;
+    }
     while (!stop.load() && !bus.stop_requested()) {
       if (plan.pipeline.max_events > 0 && summary.events >= plan.pipeline.max_events) break;
       // What came from outside (a viewer's goal or teleop) goes in first, at the data's time.

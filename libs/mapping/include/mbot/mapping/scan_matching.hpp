@@ -100,6 +100,12 @@ struct TranslationConstraint {
 };
 TranslationConstraint ScanTranslationConstraint(const std::vector<Point2>& points, double theta);
 
+// A whole-map search: the best pose of `points` anywhere on `map` at any heading (branch and bound
+// over every cell and rotation, then refined), for a lost robot or a session that starts on a
+// finished map. found = false when no pose scores `min_score`.
+MatchResult GlobalMatch(const OccupancyGrid& map, const std::vector<Point2>& points, double sigma_m,
+                        int occupied_threshold, double min_score, double min_angular_step_rad = 0.005);
+
 struct RefineOptions {
   double occupied_weight = 1.0;     // of the field term (summed over points, scaled by 1/√n)
   double translation_weight = 1.0;  // pull towards the initial position, per metre

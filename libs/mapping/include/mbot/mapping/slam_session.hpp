@@ -34,6 +34,7 @@ namespace mbot::mapping {
 struct SlamSessionOptions {
   SlamOptions slam;
   ScanOptions scan;
+  std::string known_map_name = "the known map";  // in messages (the stage's map_file)
   // Inputs.
   std::string lidar_channel, odometry_channel, ground_truth_channel, reference_channel;  // "" = first seen
   bool encoder_odometry = false;  // odometry from encoder ticks instead of an odometry channel
@@ -155,7 +156,8 @@ struct SlamCheckpointState {
 
 class SlamSession {
  public:
-  // `known_map`: localization's map, or the map a resumed run starts from.
+  // `known_map`: localization's map, the map a resumed run starts from, or (graph SLAM with
+  // initial_pose = global) the finished map the first scan is found on by a whole-map search.
   SlamSession(const SlamSessionOptions& options, uint64_t seed, std::optional<OccupancyGrid> known_map);
   SlamSession(const SlamSession&) = delete;
   SlamSession& operator=(const SlamSession&) = delete;
@@ -186,12 +188,13 @@ class SlamSession {
   void ProcessReadyScans(bool at_end, std::vector<msgs::Event>* out);
   void Control(const msgs::SlamControl& control);
   void ProcessScan(const SlamInputs::Scan& p, int64_t t_end, std::vector<msgs::Event>* out);
-  bool Initialize(int64_t t_us, const motion::Pose2D& odometry);
+  bool Initialize(int64_t t_us, const motion::Pose2D& odometry, const std::vector<ScanRay>& rays);
   void Publish(const ScanRecord& r, std::vector<msgs::Event>* out);
   void PairRecordsAndTrim(int64_t scan_start_us, int64_t max_gap_us);
 
   const SlamSessionOptions& o_;
   Slam slam_;
+  std::optional<OccupancyGrid> global_map_;  // graph SLAM: the map the first scan is searched on
   SlamInputs inputs_;
   SlamEventTracker events_;
   SensorModel consistency_model_;

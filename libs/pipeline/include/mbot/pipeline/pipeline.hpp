@@ -24,6 +24,7 @@ struct PipelineOptions {
   uint64_t seed = 1;
   std::string progress = "auto";  // auto, bar, lines, off
   long long max_events = 0;       // 0: all
+  long long skip_events = 0;      // the input's first events, read and dropped
   double playback_speed = 0.0;    // a recording paced to this many times real time (0: unpaced)
 };
 
