@@ -218,6 +218,9 @@ TEST(Transport, OutputKeysAreChecked) {
   EXPECT_NE(error("type = test_wire\nmax_rate_hz = map:0\n").find("the rate must be in (0, 1e6] Hz"),
             std::string::npos);
   EXPECT_NE(error("type = test_wire\nbogus = 1\n").find("[o] bogus: unknown key"), std::string::npos);
+  // The ros2 output only publishes: the scan-mount keys of the ros2_live source are not its keys.
+  EXPECT_NE(error("type = ros2\nrobot_frame = base_link\n").find("[o] robot_frame: unknown key"), std::string::npos);
+  EXPECT_NE(error("type = ros2\nwait_for_mount_s = 1\n").find("[o] wait_for_mount_s: unknown key"), std::string::npos);
   EXPECT_NE(error("type = lcm\nrename = LIDAR:/scan, SLAM_POSE:/scan\n").find("'/scan' names two topics"),
             std::string::npos);
 }

@@ -56,7 +56,8 @@ Qos ReaderQos(const std::string& wire) {
 
 }  // namespace
 
-Ros2NodeOptions ParseRos2NodeOptions(config::Section& s, const std::string& url, const std::string& node) {
+Ros2NodeOptions ParseRos2NodeOptions(config::Section& s, const std::string& url, const std::string& node,
+                                     bool receives_scans) {
   Ros2NodeOptions o;
   o.dds.domain_id = ParseDomain(url);
   o.dds.node_name = s.GetString("node_name", node,
@@ -73,12 +74,14 @@ Ros2NodeOptions ParseRos2NodeOptions(config::Section& s, const std::string& url,
   o.dds.config = s.GetString("dds_config", o.dds.config,
                              "ros2: Cyclone DDS configuration (XML or file://…; '' = CYCLONEDDS_URI or its defaults)");
   o.topics.Parse(s, "topics");
-  o.robot_frame = s.GetString("robot_frame", o.robot_frame,
-                              "ros2: the robot's frame, whose transform to the scan's frame (/tf_static) is the "
-                              "lidar's mount ('' = the frame /odom moves, else base_footprint)");
-  o.wait_for_mount_us = static_cast<int64_t>(
-      1e6 * s.GetDouble("wait_for_mount_s", o.wait_for_mount_us * 1e-6,
-                        "ros2: scans are held back this long waiting for /tf_static's lidar mount [s]", 0.0, 60.0));
+  if (receives_scans) {  // a node that only publishes mounts no scan: these keys would be unread
+    o.robot_frame = s.GetString("robot_frame", o.robot_frame,
+                                "ros2: the robot's frame, whose transform to the scan's frame (/tf_static) is the "
+                                "lidar's mount ('' = the frame /odom moves, else base_footprint)");
+    o.wait_for_mount_us = static_cast<int64_t>(
+        1e6 * s.GetDouble("wait_for_mount_s", o.wait_for_mount_us * 1e-6,
+                          "ros2: scans are held back this long waiting for /tf_static's lidar mount [s]", 0.0, 60.0));
+  }
   o.frames.map = s.GetString("map_frame", o.frames.map, "ros2: the map's frame");
   o.frames.odom = s.GetString("odom_frame", o.frames.odom, "ros2: the odometry's frame");
   o.frames.robot = s.GetString("base_frame", o.frames.robot, "ros2: the robot's frame (odometry's child)");
@@ -295,7 +298,7 @@ msgs::StageType Ros2BridgeStageType() {
         BridgeOptions o;
         const std::string url =
             s.GetString("url", "dds:0", "ros2_bridge: dds:<domain id> (the ROS_DOMAIN_ID of the network)");
-        o.node = ParseRos2NodeOptions(s, url, "mbot_nav_bridge");
+        o.node = ParseRos2NodeOptions(s, url, "mbot_nav_bridge", true);
         ParseTreeFrames(s, "ros2_bridge", &o.node.frames);  // the robot's side publishes the mount
         o.publish = s.GetList("publish", o.publish, "channels published (what the robot's firmware and lidar publish)");
         o.subscribe = s.GetList("subscribe", o.subscribe, "channels listened to (the autonomy's commands and outputs)");
@@ -343,7 +346,7 @@ msgs::OutputType Ros2OutputType() {
       "replay or a simulation seen in RViz or Foxglove over ROS 2; /map and /tf_static transient local";
   t.create = [](config::Section& s) -> std::unique_ptr<msgs::Output> {
     const std::string url = s.GetString("url", "dds:0", "ros2: dds:<domain id> (the ROS_DOMAIN_ID of the network)");
-    Ros2NodeOptions o = ParseRos2NodeOptions(s, url, "mbot_nav_replay");
+    Ros2NodeOptions o = ParseRos2NodeOptions(s, url, "mbot_nav_replay", false);
     ParseTreeFrames(s, "ros2", &o.frames);
     return std::make_unique<Ros2Output>(std::move(o));
   };

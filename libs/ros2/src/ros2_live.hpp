@@ -36,7 +36,9 @@ struct Ros2NodeOptions {
 std::string DefaultRosType(const std::string& topic);
 
 // [source] / [stage] keys shared by ros2_live and ros2_bridge: url (dds:<domain>), topics, frames.
-Ros2NodeOptions ParseRos2NodeOptions(config::Section& section, const std::string& url, const std::string& node);
+// `receives_scans`: the node may subscribe to scans (robot_frame, wait_for_mount_s are its keys).
+Ros2NodeOptions ParseRos2NodeOptions(config::Section& section, const std::string& url, const std::string& node,
+                                     bool receives_scans);
 
 class Ros2Node {
  public:

@@ -97,7 +97,7 @@ void RegisterRos2Transport() {
       [](config::Section& s, msgs::SourceOptions* o) {
         ParseChannelRoles(s, &o->roles);
         Ros2LiveOptions r;
-        r.node = ParseRos2NodeOptions(s, "dds:0", "mbot_nav");
+        r.node = ParseRos2NodeOptions(s, "dds:0", "mbot_nav", true);
         msgs::LiveSourceOptions d;
         d.channels = {msgs::topics::kLidar, msgs::topics::kOdometry, msgs::topics::kImu, msgs::topics::kEncoders};
         r.live = msgs::ParseLiveSourceOptions(s, "ros2_live", d);
