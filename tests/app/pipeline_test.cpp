@@ -70,6 +70,18 @@ TEST(PipelineTest, StrictErrors) {
       std::string::npos);
 }
 
+// A maze seed past an int would wrap (maze_18446744073709551615): refused, naming the key.
+TEST(PipelineTest, MazeSeedsStayInts) {
+  const std::string base = "[pipeline]\nstages = m\n[source]\ntype = none\n[m]\ntype = maze_generator\n";
+  EXPECT_NE(ErrorOf(base + "first_seed = 9223372036854775000\n")
+                .find("[m] first_seed: value 9223372036854775000 out of range"),
+            std::string::npos);
+  EXPECT_NE(
+      ErrorOf(base + "first_seed = 2147483640\ncount = 10\n").find("[m] first_seed: first_seed + count - 1 passes"),
+      std::string::npos);
+  EXPECT_EQ(ErrorOf(base + "first_seed = 2147483638\ncount = 10\n"), "");
+}
+
 // Nothing passes silently: an input without a usable event fails the run, naming the file; a
 // directory given as a log file is named as one.
 TEST(PipelineTest, AnEmptyInputFailsTheRun) {

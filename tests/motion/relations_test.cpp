@@ -41,6 +41,27 @@ TEST(Relations, ABadLineIsAnErrorNamingFileAndLine) {
   }
 }
 
+// Values no relation can have are refused naming the line; a huge line is not echoed whole. A
+// relation whose t2 comes before t1 is read (Intel's hand-checked file has six).
+TEST(Relations, ImplausibleValuesAreRefusedAndLongLinesShortened) {
+  auto error = [](const std::string& text) {
+    try {
+      ReadRelations(WriteTemp("rel_hostile.relations", text));
+    } catch (const RelationsError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error("1 2 0 0 0 0 0 0\n1 2 1e300 0 0 0 0 0\n").find("rel_hostile.relations:2: a relative position"),
+            std::string::npos);
+  EXPECT_NE(error("1 2 0 0 0 0 0 1e300\n").find(":1: an angle beyond 4 pi"), std::string::npos);
+  const std::string huge = error("1 2 3 " + std::string(100000, '7') + "x\n");
+  EXPECT_NE(huge.find(":1: a relation is eight numbers"), std::string::npos);
+  EXPECT_LT(huge.size(), 400u);
+  EXPECT_NE(huge.find("100007 bytes"), std::string::npos) << huge;
+  EXPECT_EQ(ReadRelations(WriteTemp("rel_back.relations", "12.5 11.75 0.3 0 0 0 0 0.05\n")).size(), 1u);
+}
+
 TEST(Relations, ScoresTheErrorOfEachRelativeMotion) {
   std::map<int64_t, Pose2D> poses{{1'000'000, {0, 0, 0}}, {2'000'000, {1.0, 0, 0}}, {3'000'000, {1.0, 1.0, M_PI / 2}}};
   // Exact relations: no error.

@@ -81,6 +81,10 @@ TEST(SimWorld, ParseErrorsNameTheLineAndToken) {
             "a.arena:3: 'thickness' 0.05 differs from the 0.02 m of the walls before (line 2); an arena has one "
             "wall thickness");
   EXPECT_EQ(ParseError("pose start 0 0\n"), "a.arena:1: 'pose' needs <label> <x> <y> <theta_deg> (4 values), got 3");
+  EXPECT_EQ(ParseError("pose start 0 0 1e308\n"),
+            "a.arena:1: 'pose': heading 1e308 deg is not a heading (|theta| <= 360000)");
+  EXPECT_EQ(ParseError("wall 0 0 1 1\npose start 0 0 0\npose start 1 0 0\n"),
+            "a.arena:3: a second 'pose start' (the first is on line 2)");
   EXPECT_EQ(ParseError("name\n"), "a.arena:1: 'name' needs a text");
   EXPECT_EQ(ParseError("name a room  # no walls yet\npose start 0 0 0\n"),
             "a.arena: no walls (an arena needs at least one 'wall' or 'box')");

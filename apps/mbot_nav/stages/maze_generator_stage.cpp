@@ -1,5 +1,6 @@
 // `maze_generator`: writes seeded botlab-style mazes (libs/sim) as arena files, with a PNG of each
 // and an index (mazes.csv); the simulator and the Maze Explorer take them as source.path.
+#include <climits>
 #include <cstdio>
 #include <sstream>
 
@@ -65,7 +66,11 @@ static StageType MazeGeneratorStageType() {
             MazeGeneratorOptions o;
             sim::MazeStyle& st = o.style;
             o.count = s.GetInt("count", o.count, "how many mazes", 1, 100000);
-            o.first_seed = s.GetInt("first_seed", o.first_seed, "seed of the first maze; the others count up", 0);
+            // Seeds are ints end to end (the sweep's seeds, the arena names): the last one must be one too.
+            o.first_seed = static_cast<int>(
+                s.GetInt("first_seed", o.first_seed, "seed of the first maze; the others count up", 0, INT_MAX));
+            if (static_cast<long long>(o.first_seed) + o.count - 1 > INT_MAX)
+              s.Fail("first_seed", "first_seed + count - 1 passes " + std::to_string(INT_MAX));
             o.basename = s.GetString("basename", o.basename, "files are <basename>_<seed>.arena/.png");
             if (o.basename.empty() || o.basename.find('/') != std::string::npos)
               s.Fail("basename", "must be a plain file name");

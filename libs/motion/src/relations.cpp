@@ -55,8 +55,10 @@ std::vector<Relation> ReadRelations(const std::string& path) {
     while (k < 8 && s >> v[k]) ++k;
     std::string rest;
     if (k < 8 || (s >> rest)) {
+      const std::string shown =
+          line.size() > 120 ? line.substr(0, 120) + "… (" + std::to_string(line.size()) + " bytes)" : line;
       throw RelationsError(path + ":" + std::to_string(n) +
-                           ": a relation is eight numbers (t1 t2 x y z roll pitch yaw): '" + line + "'");
+                           ": a relation is eight numbers (t1 t2 x y z roll pitch yaw): '" + shown + "'");
     }
     for (double x : v) {
       if (!std::isfinite(x)) throw RelationsError(path + ":" + std::to_string(n) + ": a value is not finite");
@@ -64,6 +66,12 @@ std::vector<Relation> ReadRelations(const std::string& path) {
     if (v[0] < 0 || v[1] < 0 || v[0] > 4.1e9 || v[1] > 4.1e9) {
       throw RelationsError(path + ":" + std::to_string(n) + ": a timestamp is not seconds since 1970");
     }
+    // A relation joins two poses of one building; its angles are radians. (t2 may come before t1:
+    // Intel's hand-checked relations have six such, between scans whose arrival stamps jitter.)
+    if (std::abs(v[2]) > 1e5 || std::abs(v[3]) > 1e5 || std::abs(v[4]) > 1e5)
+      throw RelationsError(path + ":" + std::to_string(n) + ": a relative position beyond 100 km is not a relation");
+    if (std::abs(v[5]) > 4 * M_PI || std::abs(v[6]) > 4 * M_PI || std::abs(v[7]) > 4 * M_PI)
+      throw RelationsError(path + ":" + std::to_string(n) + ": an angle beyond 4 pi (radians) is not a relation");
     out.push_back({ToMicros(v[0]), ToMicros(v[1]), Pose2D{v[2], v[3], v[7]}, n});
   }
   return out;

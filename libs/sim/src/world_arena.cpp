@@ -78,6 +78,13 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
     if (r.ec != std::errc() || !std::isfinite(v)) fail("'" + stmt + "': '" + tok + "' is not a finite number");
     return v;
   };
+  // A heading in degrees: beyond a thousand turns it is no heading (and 1e308 × π overflows to inf).
+  auto heading = [&](const std::string& stmt, const std::string& tok) {
+    const double deg = number(stmt, tok);
+    if (std::abs(deg) > 360000.0) fail("'" + stmt + "': heading " + tok + " deg is not a heading (|theta| <= 360000)");
+    return motion::WrapAngle(deg * kPi / 180.0);
+  };
+  int start_line = 0;
   while (std::getline(in, raw)) {
     ++line_no;
     const auto hash = raw.find('#');
@@ -139,7 +146,11 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
       p.label = args[0];
       p.pose.x = number(stmt, args[1]);
       p.pose.y = number(stmt, args[2]);
-      p.pose.theta = motion::WrapAngle(number(stmt, args[3]) * kPi / 180.0);
+      p.pose.theta = heading(stmt, args[3]);
+      if (p.label == "start") {
+        if (start_line) fail("a second 'pose start' (the first is on line " + std::to_string(start_line) + ")");
+        start_line = line_no;
+      }
       poses.push_back(p);
     } else if (stmt == "crate") {
       if (args.size() != 4 && args.size() != 7) {
@@ -149,7 +160,7 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
       const double id = number(stmt, args[0]);
       if (id < 0 || id > 586 || id != std::floor(id)) fail("'crate' id " + args[0] + " is not a tag36h11 id (0-586)");
       c.id = static_cast<int>(id);
-      c.pose = {number(stmt, args[1]), number(stmt, args[2]), motion::WrapAngle(number(stmt, args[3]) * kPi / 180.0)};
+      c.pose = {number(stmt, args[1]), number(stmt, args[2]), heading(stmt, args[3])};
       if (args.size() == 7) {
         c.width_m = number(stmt, args[4]), c.depth_m = number(stmt, args[5]), c.height_m = number(stmt, args[6]);
       }
