@@ -15,7 +15,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 targets=(lcm_log lcm_messages rawlog carmen botlab_map pgm_yaml gridmap simplemap movingai_map
-  movingai_scenarios motor_csv ini mcap cdr ros1_bag)
+  movingai_scenarios motor_csv ini mcap cdr ros1_bag arena camera_yaml relations image_folder)
 
 usage() { sed -n '2,5p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
 [ $# -ge 1 ] || usage
@@ -67,6 +67,18 @@ make_seeds() {
         head -c 32 /dev/zero | tr '\0' '\376'; } > "$dir/seed_trinary"
       { printf 'image: map.pgm\nresolution: 0.1\norigin: [0, 0, 0]\nnegate: 1\nmode: scale\n\0P2\n3 2\n255\n'
         printf '0 128 255\n255 0 7\n'; } > "$dir/seed_scale" ;;
+    image_folder)  # a small PNG and JPEG of an AprilTag test photo's kind: the first byte picks the name
+      python3 - "$dir" <<'PY'
+import struct, sys, zlib
+d = sys.argv[1]
+w, h = 16, 8
+raw = b"".join(b"\0" + bytes((x * 16) & 255 for x in range(w)) for _ in range(h))
+def chunk(t, b): return struct.pack(">I", len(b)) + t + b + struct.pack(">I", zlib.crc32(t + b) & 0xffffffff)
+png = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 0, 0, 0, 0)) + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
+open(d + "/seed_png", "wb").write(b"\0" + png)
+open(d + "/seed_pgm", "wb").write(b"\3" + b"P5\n%d %d\n255\n" % (w, h) + bytes(w * h))
+PY
+      ;;
     movingai_scenarios)
       printf 'version 1\n0\ttiny.map\t8\t8\t0\t0\t7\t7\t9.89949494\n0\ttiny.map\t8\t8\t0\t7\t7\t0\t9.89949494\n' \
         > "$dir/seed_tiny" ;;

@@ -568,5 +568,71 @@ TEST(SimWorld, CratesAreSeenAndTouchedButNotMapped) {
             std::string::npos);
 }
 
+// Crates and stacks that cannot be right are refused at load, naming the line.
+TEST(SimWorld, CratesAndStacksThatCannotBeRightAreRefused) {
+  const std::string room = "box -1 -1 1 1\n";
+  EXPECT_EQ(ParseError(room + "crate 7 0.5 0 0\ncrate 7 -0.5 0 0\n"),
+            "a.arena:3: 'crate' id 7 given twice (first at line 2)");
+  EXPECT_EQ(ParseError(room + "crate 7 0.5 0 0\nstack 7 9\n"),
+            "a.arena:3: 'stack' names crate 9, which no 'crate' or 'crates_at_random' places");
+  EXPECT_EQ(ParseError(room + "crate 7 0.5 0 0\ncrate 8 -0.5 0 0\nstack 7 8\nstack 8 7\n"),
+            "a.arena:5: 'stack' makes a cycle: 8 on 7 on 8");
+  EXPECT_EQ(ParseError(room + "crate 7 0.5 0 0\ncrate 8 -0.5 0 0\ncrate 9 0 0.5 0\nstack 7 8\nstack 7 9\n"),
+            "a.arena:6: 'stack': crate 7 is stacked twice (first at line 5)");
+  EXPECT_EQ(ParseError(room + "crates_at_random 3 0 0 0.5 1\ncrate 2 0.8 0.8 0\n"),
+            "a.arena:3: 'crate' id 2 is also one of the ids of 'crates_at_random' (line 2)");
+  // Outside the walls: beside the room, and beside a room that has a start pose.
+  EXPECT_EQ(ParseError(room + "box 3 -1 5 1\ncrate 7 2 0 0\n"), "a.arena:3: crate 7 at (2, 0) is outside the walls");
+  EXPECT_EQ(ParseError(room + "box 3 -1 5 1\npose start 0 0 0\ncrate 7 4 0 0\n"),
+            "a.arena:4: crate 7 at (4, 0) is outside the free space of 'pose start'");
+  EXPECT_EQ(ParseError(room + "pose start 0 0 0\ncrates_at_random 2 5 5\n"),
+            "a.arena:3: 'crates_at_random' centre (5, 5) is outside the free space of 'pose start'");
+  // A chain (one crate on another that stands on a third) is a stack, not a cycle.
+  EXPECT_NO_THROW(World::ParseArena(room + "crate 7 0.5 0 0\ncrate 8 -0.5 0 0\ncrate 9 0 0.5 0\nstack 7 8\nstack 8 9\n",
+                                    "a.arena"));
+}
+
+// Sizes that would take gigabytes or minutes are refused or stay cheap.
+TEST(SimWorld, HugeArenasAreRefusedAndLongWallsLoadAlongTheirLength) {
+  // 0.005 m over a 99 m box: 392 M cells (1.5 GB before), refused naming the resolution's line.
+  const std::string big = ParseError("resolution 0.005\nbox 0 0 99 99\n");
+  EXPECT_EQ(big.rfind("a.arena: the walls span 99 x 99 m, too large for a true map at 0.005 m", 0), 0u) << big;
+  EXPECT_NE(big.find("(resolution on line 1)"), std::string::npos) << big;
+  // A box of 100 m with long diagonal walls: each is rasterised along its length (this took 0.13 s a
+  // wall when every cell of its bounding box was tested).
+  std::string walls = "box 0 0 100 100\n";
+  for (int k = 0; k < 400; ++k)
+    walls += "wall 1 " + std::to_string(1 + k * 0.2) + " 99 " + std::to_string(99 - k * 0.2) + "\n";
+  const World w = World::ParseArena(walls, "diagonals.arena");
+  EXPECT_EQ(w.walls().size(), 404u);
+  // Every cell is wall exactly when its centre is within thickness/2 + resolution/2 of a wall.
+  const World few = World::ParseArena(
+      "resolution 0.05\nwall 0.1 0.2 3.3 1.7\nwall 3 0.1 0.4 2.9\nwall 0 2 3 2\n"
+      "wall 1 0 1 3\nwall 2 3 2.01 0\n",
+      "few.arena");
+  const double reach = 0.01 + 0.025;
+  const auto& g = few.truth();
+  int walls_seen = 0;
+  for (int j = 0; j < g.height(); ++j) {
+    for (int i = 0; i < g.width(); ++i) {
+      double x, y;
+      g.CellToWorld(i, j, &x, &y);
+      double d2 = 1e18;
+      for (const auto& s : few.walls()) {
+        const double dx = s.x1 - s.x0, dy = s.y1 - s.y0;
+        const double t = std::clamp(((x - s.x0) * dx + (y - s.y0) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
+        d2 = std::min(d2, std::pow(x - s.x0 - t * dx, 2) + std::pow(y - s.y0 - t * dy, 2));
+      }
+      const bool wall = d2 <= reach * reach;
+      walls_seen += wall;
+      ASSERT_EQ(g.at(i, j), wall ? 127 : -127) << i << " " << j;
+    }
+  }
+  EXPECT_GT(walls_seen, 300);
+  std::string many = "box 0 0 10 10\n";
+  for (int k = 0; k < 100001; ++k) many += "wall 1 1 2 2\n";
+  EXPECT_EQ(ParseError(many), "a.arena:99998: more than 100000 walls in one arena");  // 4 from the box
+}
+
 }  // namespace
 }  // namespace mbot::sim

@@ -116,6 +116,36 @@ TEST(CameraCalibrationTest, CameraYamlRoundTripsWithOpenCvKeys) {
   }
 }
 
+// A camera that cannot be right is refused when read, naming the file and the key: a focal length
+// of NaN, 0, infinity, 1e30 or below zero, NaN distortion, 3 distortion coefficients, a bad size.
+TEST(CameraCalibrationTest, CamerasThatCannotBeRightAreRefusedNamingTheKey) {
+  const std::string path = ::testing::TempDir() + "/camera_hostile.yaml";
+  auto error = [&](const std::string& fx, const std::string& distortion, int rows = 5, const std::string& w = "640") {
+    std::ofstream(path) << "%YAML:1.0\n---\nimage_width: " << w << "\nimage_height: 480\n"
+                        << "camera_matrix: !!opencv-matrix\n   rows: 3\n   cols: 3\n   dt: d\n   data: [ " << fx
+                        << ", 0., 320., 0., 530., 240., 0., 0., 1. ]\n"
+                        << "distortion_coefficients: !!opencv-matrix\n   rows: " << rows
+                        << "\n   cols: 1\n   dt: d\n   data: [ " << distortion << " ]\n";
+    try {
+      ReadCameraYaml(path);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  const std::string zeros = "0., 0., 0., 0., 0.";
+  EXPECT_EQ(error("530.", zeros), "(no error)");
+  for (const char* fx : {".nan", "0.", ".inf", "1e30", "-530."}) {
+    const std::string e = error(fx, zeros);
+    EXPECT_EQ(e.rfind(path + ": camera_matrix: ", 0), 0u) << fx << ": " << e;
+  }
+  EXPECT_NE(error("1e30", zeros).find("is not a focal length (0 < fx <= 64000 px)"), std::string::npos);
+  EXPECT_EQ(error("530.", "0., .nan, 0., 0., 0."), path + ": distortion_coefficients: value 1 is nan");
+  EXPECT_EQ(error("530.", "0.1, 0., 0.", 3),
+            path + ": distortion_coefficients: has 3 values; OpenCV takes 4, 5, 8, 12 or 14");
+  EXPECT_EQ(error("530.", zeros, 5, "0"), path + ": image_width: 0 px is not in 1-16384");
+}
+
 // Grey, BGR and BGRA views all come out as BGR to draw on (a colour camera's views once failed here).
 TEST(CameraCalibrationTest, ViewsOfAnyChannelCountDrawInColour) {
   for (int type : {CV_8UC1, CV_8UC3, CV_8UC4}) {

@@ -183,7 +183,7 @@ static StageType OdometryStageType() {
             o.fusion.estimate_bias = s.GetBool("estimate_bias", o.fusion.estimate_bias,
                                                "estimate the gyro bias while the wheels stand still at the start");
             o.max_pose_gap_s = s.GetDouble("max_pose_gap_s", o.max_pose_gap_s,
-                                           "ground truth is interpolated across gaps up to this", 0.0);
+                                           "ground truth is interpolated across gaps up to this", 0.0, 3600.0);
             o.png_pixels_per_m = static_cast<int>(
                 s.GetInt("png_pixels_per_m", o.png_pixels_per_m, "resolution of odometry_comparison.png", 1, 1000));
             return std::make_unique<OdometryStage>(o);

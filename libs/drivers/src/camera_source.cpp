@@ -11,6 +11,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "mbot/common/log.hpp"
+#include "mbot/drivers/image_header.hpp"
 
 namespace mbot::drivers {
 
@@ -124,6 +125,15 @@ CameraSource::CameraSource(const SourceOptions& options) : impl_(std::make_uniqu
     m.device = pipeline;  // a pipeline is live; a video file replays
     if (!pipeline) m.total_frames = static_cast<int64_t>(m.capture.get(cv::CAP_PROP_FRAME_COUNT));
   }
+  // Every file is checked before the first is decoded: a size beyond what is read, a file cut short
+  // or no image at all stops the run at load, naming the file.
+  for (const std::string& file : m.files) {
+    try {
+      CheckImageFile(file);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(std::string("camera source: ") + e.what());
+    }
+  }
   channels_[m.o.channel] = ChannelInfo{"8-bit grey image", "", EventKind::kCameraFrame, true};
 }
 
@@ -135,8 +145,12 @@ std::optional<Event> CameraSource::Next() {
     const std::string& file = m.files[m.next_file++];
     // Grey straight from the file: a JPEG's own luma, as the AprilTag library's reader takes it (a
     // colour decode converted back to grey moves tag corners by up to 0.3 px on its test photos).
-    cv::Mat image =
-        cv::imread(file, m.o.color ? cv::IMREAD_UNCHANGED : cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION);
+    cv::Mat image;
+    try {
+      image = cv::imread(file, m.o.color ? cv::IMREAD_UNCHANGED : cv::IMREAD_GRAYSCALE | cv::IMREAD_IGNORE_ORIENTATION);
+    } catch (const cv::Exception& e) {  // OpenCV's own limits, in a message naming no file
+      throw std::runtime_error("camera source: " + file + ": OpenCV cannot read it (" + e.msg + ")");
+    }
     if (image.empty() || image.depth() != CV_8U) {
       mbot::log::Warn("camera source: skipped " + file + " (not an 8-bit image OpenCV can read)");
       ++m.unreadable;

@@ -62,7 +62,8 @@ SlamSessionOptions ParseSlamSessionOptions(config::Section& s) {
       std::llround(s.GetDouble("lidar_time_offset_s", 0.0,
                                "added to a scan's time (its last beam) before poses are looked up", -1.0, 1.0) *
                    1e6));
-  o.max_pose_gap_s = s.GetDouble("max_pose_gap_s", 0.5, "largest gap in a pose series to interpolate across", 0.0);
+  o.max_pose_gap_s =
+      s.GetDouble("max_pose_gap_s", 0.5, "largest gap in a pose series to interpolate across", 0.0, 3600.0);
 
   // Start.
   const std::vector<std::string> init =

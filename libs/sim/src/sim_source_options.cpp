@@ -139,6 +139,11 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& wo
   if (!calibration.empty() && !s.describing()) {
     try {
       const vision::CalibrationResult cal = vision::ReadCameraYaml(calibration);
+      if (cal.image_width < 16 || cal.image_height < 16 || cal.image_width > 8192 || cal.image_height > 8192) {
+        throw std::invalid_argument(calibration + ": image_width x image_height = " + std::to_string(cal.image_width) +
+                                    " x " + std::to_string(cal.image_height) +
+                                    " is outside the simulated camera's 16-8192 px a side");
+      }
       c.width = cal.image_width, c.height = cal.image_height;
       c.intrinsics = vision::IntrinsicsFromYaml(calibration);
     } catch (const std::exception& e) {

@@ -221,9 +221,11 @@ World World::FromSegments(std::vector<WallSegment> walls, double thickness_m, do
   const double res = resolution_m;
   const double cells_x = (max_x - min_x + 2 * h) / res + 2 * kMarginCells + 2;
   const double cells_y = (max_y - min_y + 2 * h) / res + 2 * kMarginCells + 2;
-  if (cells_x > kMaxCellsPerSide || cells_y > kMaxCellsPerSide) {
+  if (cells_x > kMaxCellsPerSide || cells_y > kMaxCellsPerSide || cells_x * cells_y > kMaxWorldCells) {
     throw std::runtime_error("the walls span " + Num(max_x - min_x) + " x " + Num(max_y - min_y) +
-                             " m, too large for a true map at " + Num(res) + " m");
+                             " m, too large for a true map at " + Num(res) + " m (" + Num(std::ceil(cells_x)) + " x " +
+                             Num(std::ceil(cells_y)) + " cells; at most " + Num(kMaxCellsPerSide) + " a side and " +
+                             Num(kMaxWorldCells) + " in all)");
   }
   // True map: cell-aligned to multiples of the resolution, a margin of free cells around.
   const int gx0 = static_cast<int>(std::floor((min_x - h) / res)) - kMarginCells;
@@ -235,14 +237,20 @@ World World::FromSegments(std::vector<WallSegment> walls, double thickness_m, do
   auto& g = w.truth_;
   const double reach = h + 0.5 * res;  // cell centres this near a segment are wall: no gaps
   for (const auto& c : index->capsules) {
-    const double bx0 = std::min(c.ax, c.ax + c.ux * c.len) - reach, bx1 = std::max(c.ax, c.ax + c.ux * c.len) + reach;
+    // Row by row, only the stretch the capsule can reach: the cost grows with a wall's length, not
+    // with its bounding box (a long diagonal wall's box holds millions of cells it does not touch).
     const double by0 = std::min(c.ay, c.ay + c.uy * c.len) - reach, by1 = std::max(c.ay, c.ay + c.uy * c.len) + reach;
     int i0, j0, i1, j1;
-    g.WorldToCell(bx0, by0, &i0, &j0);
-    g.WorldToCell(bx1, by1, &i1, &j1);
+    g.WorldToCell(c.ax, by0, &i0, &j0);
+    g.WorldToCell(c.ax, by1, &i1, &j1);
     for (int j = std::max(j0, 0); j <= std::min(j1, g.height() - 1); ++j) {
-      for (int i = std::max(i0, 0); i <= std::min(i1, g.width() - 1); ++i) {
-        double cx, cy;
+      double cx, cy, x_lo, x_hi;
+      g.CellToWorld(0, j, &cx, &cy);
+      if (!RowSpan(c, cy, reach, &x_lo, &x_hi)) continue;
+      int ia, ib, jj;
+      g.WorldToCell(x_lo, cy, &ia, &jj);
+      g.WorldToCell(x_hi, cy, &ib, &jj);
+      for (int i = std::max(ia, 0); i <= std::min(ib, g.width() - 1); ++i) {
         g.CellToWorld(i, j, &cx, &cy);
         if (SegmentDist2(c, cx, cy) <= reach * reach) g.at(i, j) = 127;
       }
@@ -259,19 +267,22 @@ World World::FromSegments(std::vector<WallSegment> walls, double thickness_m, do
   std::vector<std::vector<int>> lists(static_cast<size_t>(index->nbx) * index->nby);
   for (size_t k = 0; k < index->capsules.size(); ++k) {
     const auto& c = index->capsules[k];
-    const double ex = c.ax + c.ux * c.len, ey = c.ay + c.uy * c.len;
+    const double ey = c.ay + c.uy * c.len;
     auto bucket_of = [&](double v, double o, int n) {
       return std::clamp(static_cast<int>(std::floor((v - o) / index->bucket)), 0, n - 1);
     };
-    const int i0 = bucket_of(std::min(c.ax, ex) - h, index->x0, index->nbx);
-    const int i1 = bucket_of(std::max(c.ax, ex) + h, index->x0, index->nbx);
     const int j0 = bucket_of(std::min(c.ay, ey) - h, index->y0, index->nby);
     const int j1 = bucket_of(std::max(c.ay, ey) + h, index->y0, index->nby);
+    const double r = h + index->bucket * std::sqrt(0.5);
     for (int j = j0; j <= j1; ++j) {
+      // Keep only buckets the capsule really reaches (a diagonal wall's box holds many it does not),
+      // looking only along the stretch of this row it can reach.
+      const double cy = index->y0 + (j + 0.5) * index->bucket;
+      double x_lo, x_hi;
+      if (!RowSpan(c, cy, r, &x_lo, &x_hi)) continue;
+      const int i0 = bucket_of(x_lo, index->x0, index->nbx), i1 = bucket_of(x_hi, index->x0, index->nbx);
       for (int i = i0; i <= i1; ++i) {
-        // Keep only buckets the capsule really reaches (a diagonal wall's box holds many it does not).
-        const double cx = index->x0 + (i + 0.5) * index->bucket, cy = index->y0 + (j + 0.5) * index->bucket;
-        const double r = h + index->bucket * std::sqrt(0.5);
+        const double cx = index->x0 + (i + 0.5) * index->bucket;
         if (SegmentDist2(c, cx, cy) <= r * r) lists[index->BucketIndex(i, j)].push_back(static_cast<int>(k));
       }
     }
@@ -289,6 +300,10 @@ World World::FromSegments(std::vector<WallSegment> walls, double thickness_m, do
 
 World World::FromGrid(const mapping::OccupancyGrid& grid) {
   if (grid.width() <= 0 || grid.height() <= 0) throw std::runtime_error("a grid world needs a non-empty grid");
+  if (static_cast<double>(grid.width()) * grid.height() > kMaxWorldCells) {
+    throw std::runtime_error("a map of " + std::to_string(grid.width()) + " x " + std::to_string(grid.height()) +
+                             " cells is too large for a world (at most " + Num(kMaxWorldCells) + " cells)");
+  }
   World w;
   w.thickness_ = 0.0;
   w.truth_ = mapping::OccupancyGrid(grid.width(), grid.height(), grid.resolution(), grid.origin_x(), grid.origin_y());

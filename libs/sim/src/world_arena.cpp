@@ -59,6 +59,8 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
   std::vector<std::pair<Crate, int>> crates;  // with their lines, added once the walls exist
   std::optional<CrateArea> crate_area;
   std::vector<std::pair<int, int>> stacks;
+  std::vector<int> stack_lines;
+  int crate_area_line = 0;
   std::string name;
   double thickness = 0.02, resolution = 0.025;
   int name_line = 0, resolution_line = 0, first_wall_line = 0;
@@ -140,6 +142,7 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
         walls.push_back({xa, yb, xa, ya});
       }
       if (!first_wall_line) first_wall_line = line_no;
+      if (walls.size() > kMaxWalls) fail("more than " + std::to_string(kMaxWalls) + " walls in one arena");
     } else if (stmt == "pose") {
       need(4, "<label> <x> <y> <theta_deg> (4 values)");
       ArenaPose p;
@@ -164,6 +167,9 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
       if (args.size() == 7) {
         c.width_m = number(stmt, args[4]), c.depth_m = number(stmt, args[5]), c.height_m = number(stmt, args[6]);
       }
+      for (const auto& [other, at] : crates) {
+        if (other.id == c.id) fail("'crate' id " + args[0] + " given twice (first at line " + std::to_string(at) + ")");
+      }
       crates.push_back({c, line_no});
     } else if (stmt == "crates_at_random") {
       if (args.size() != 3 && args.size() != 5) {
@@ -186,6 +192,7 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
         a.first_id = static_cast<int>(first);
       }
       crate_area = a;
+      crate_area_line = line_no;
     } else if (stmt == "stack") {
       if (args.size() != 2)
         fail("'stack' needs <crate id> <id of the crate it goes on>, got " + std::to_string(args.size()));
@@ -193,22 +200,98 @@ World World::ParseArena(const std::string& text, const std::string& origin) {
       if (a < 0 || b < 0 || a > 586 || b > 586 || a != std::floor(a) || b != std::floor(b) || a == b)
         fail("'stack' needs two different tag36h11 ids (0-586), got " + args[0] + " " + args[1]);
       stacks.emplace_back(static_cast<int>(a), static_cast<int>(b));
+      stack_lines.push_back(line_no);
     } else {
       fail("unknown statement '" + stmt +
            "' (known: name, resolution, thickness, wall, box, pose, crate, crates_at_random, stack)");
     }
   }
   if (walls.empty()) throw std::runtime_error(origin + ": no walls (an arena needs at least one 'wall' or 'box')");
+  // Every crate a stack names exists, none is stacked twice, and no stack leads back to itself.
+  auto crate_exists = [&](int id) {
+    if (crate_area && id >= crate_area->first_id && id < crate_area->first_id + crate_area->count) return true;
+    return std::any_of(crates.begin(), crates.end(), [&](const auto& c) { return c.first.id == id; });
+  };
+  for (size_t k = 0; k < stacks.size(); ++k) {
+    line_no = stack_lines[k];
+    const auto [top, bottom] = stacks[k];
+    for (const int id : {top, bottom}) {
+      if (!crate_exists(id))
+        fail("'stack' names crate " + std::to_string(id) + ", which no 'crate' or 'crates_at_random' places");
+    }
+    for (size_t e = 0; e < k; ++e) {
+      if (stacks[e].first == top) {
+        fail("'stack': crate " + std::to_string(top) + " is stacked twice (first at line " +
+             std::to_string(stack_lines[e]) + ")");
+      }
+    }
+    std::string chain = std::to_string(top);
+    for (int at = bottom, steps = 0;; ++steps) {
+      chain += " on " + std::to_string(at);
+      if (at == top) fail("'stack' makes a cycle: " + chain);
+      const auto next = std::find_if(stacks.begin(), stacks.begin() + static_cast<std::ptrdiff_t>(k),
+                                     [&](const auto& st) { return st.first == at; });
+      if (next == stacks.begin() + static_cast<std::ptrdiff_t>(k) || steps > static_cast<int>(stacks.size())) break;
+      at = next->second;
+    }
+  }
+  if (crate_area) {
+    for (const auto& [c, at] : crates) {
+      if (c.id >= crate_area->first_id && c.id < crate_area->first_id + crate_area->count) {
+        line_no = at;
+        fail("'crate' id " + std::to_string(c.id) + " is also one of the ids of 'crates_at_random' (line " +
+             std::to_string(crate_area_line) + ")");
+      }
+    }
+  }
   World w;
   try {
     w = FromSegments(std::move(walls), thickness, resolution);
   } catch (const std::exception& e) {
-    throw std::runtime_error(origin + ": " + e.what());
+    throw std::runtime_error(origin + ": " + e.what() +
+                             (resolution_line ? " (resolution on line " + std::to_string(resolution_line) + ")" : ""));
   }
   w.name_ = name.empty() ? fs::path(origin).stem().string() : name;
   w.poses_ = std::move(poses);
   w.crate_area_ = crate_area;
   w.stacks_ = std::move(stacks);
+  // Crates stand in the room: in the start's free space, or, without a start, off the free space
+  // around the walls (the true map's margin).
+  if (!crates.empty() || crate_area) {
+    const auto& g = w.truth();
+    const std::vector<motion::Pose2D> starts = w.PosesLabelled("start");
+    std::vector<uint8_t> outside;
+    bool room_is_start = false;
+    if (!starts.empty()) {
+      int sx, sy;
+      g.WorldToCell(starts.front().x, starts.front().y, &sx, &sy);
+      if (g.IsInside(sx, sy) && g.at(sx, sy) < 0) {
+        outside = ReachableFreeMask(w, starts.front());
+        room_is_start = true;
+      }
+    }
+    if (!room_is_start)
+      outside = ReachableFreeMask(w, {g.origin_x() + 0.5 * g.resolution(), g.origin_y() + 0.5 * g.resolution(), 0.0});
+    auto in_room = [&](double x, double y) {
+      int i, j;
+      g.WorldToCell(x, y, &i, &j);
+      if (!g.IsInside(i, j)) return false;
+      if (g.at(i, j) >= 0) return true;  // on a wall: AddCrate says it overlaps one
+      const bool reached = outside[static_cast<size_t>(j) * g.width() + i] != 0;
+      return room_is_start ? reached : !reached;
+    };
+    const std::string room = room_is_start ? "the free space of 'pose start'" : "the walls";
+    for (const auto& [c, at] : crates) {
+      if (!in_room(c.pose.x, c.pose.y)) {
+        throw std::runtime_error(origin + ":" + std::to_string(at) + ": crate " + std::to_string(c.id) + " at (" +
+                                 Num(c.pose.x) + ", " + Num(c.pose.y) + ") is outside " + room);
+      }
+    }
+    if (crate_area && !in_room(crate_area->x, crate_area->y)) {
+      throw std::runtime_error(origin + ":" + std::to_string(crate_area_line) + ": 'crates_at_random' centre (" +
+                               Num(crate_area->x) + ", " + Num(crate_area->y) + ") is outside " + room);
+    }
+  }
   for (const auto& [crate, at] : crates) {
     try {
       w.AddCrate(crate);

@@ -1,7 +1,10 @@
 // The limits the arena parser and the world builders share, and their number formatting.
 #pragma once
 
+#include <algorithm>
 #include <charconv>
+#include <cmath>
+#include <cstddef>
 #include <limits>
 #include <string>
 
@@ -16,6 +19,11 @@ constexpr double kMinThickness = 0.001, kMaxThickness = 1.0;
 constexpr int kMarginCells = 4;
 // Largest true map side [cells]: a typo in a coordinate should fail, not allocate gigabytes.
 constexpr double kMaxCellsPerSide = 20000;
+// Largest true map [cells]: 64 Mi cells (a 80 x 80 m arena at 1 cm) take about 0.3 GB with the
+// distance transform's 4 bytes a cell; 0.005 m over a 100 m box would be 1.5 GB.
+constexpr double kMaxWorldCells = 64.0 * 1024 * 1024;
+// Walls in one arena (each is rasterised along its length, so loading grows with their total length).
+constexpr size_t kMaxWalls = 100000;
 // Bucket side of the arena acceleration grid [m]. On maze_3 (16 walls, mean ray 0.7 m), 0.45–1.0 m
 // buckets all cast about 4.5–5 M rays/s, 0.15 m ones 2.9 M, one bucket for everything 2.6 M.
 constexpr double kBucketSize = 0.5;
@@ -69,6 +77,24 @@ inline double SegmentDist2(const Capsule& c, double px, double py) {
   const double ov = -wx * c.uy + wy * c.ux;
   const double eu = ou - std::clamp(ou, 0.0, c.len);
   return eu * eu + ov * ov;
+}
+
+// The stretch of the horizontal line at `y` within `r` of the capsule's centre segment, as a
+// superset [x_lo, x_hi]; false when the line is farther than `r` from the segment.
+inline bool RowSpan(const Capsule& c, double y, double r, double* x_lo, double* x_hi) {
+  double s0 = 0.0, s1 = c.len;
+  if (std::abs(c.uy) < 1e-12) {
+    if (std::abs(y - c.ay) > r) return false;
+  } else {
+    const double sa = (y - r - c.ay) / c.uy, sb = (y + r - c.ay) / c.uy;
+    s0 = std::max(s0, std::min(sa, sb));
+    s1 = std::min(s1, std::max(sa, sb));
+    if (s0 > s1) return false;
+  }
+  const double xa = c.ax + c.ux * s0, xb = c.ax + c.ux * s1;
+  *x_lo = std::min(xa, xb) - r;
+  *x_hi = std::max(xa, xb) + r;
+  return true;
 }
 
 }  // namespace mbot::sim::world_limits

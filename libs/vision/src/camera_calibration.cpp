@@ -133,6 +133,52 @@ void WriteCameraYaml(const CalibrationResult& r, const ChessboardOptions& o, con
   CommitFile(tmp, path);
 }
 
+void ValidateCamera(CalibrationResult& r, const std::string& path) {
+  auto fail = [&](const std::string& key, const std::string& why) {
+    throw std::runtime_error(path + ": " + key + ": " + why);
+  };
+  auto text = [](double v) { return std::isnan(v) ? std::string("nan") : std::to_string(v); };
+  if (r.image_width < 1 || r.image_width > kMaxCameraSidePx)
+    fail("image_width", std::to_string(r.image_width) + " px is not in 1-" + std::to_string(kMaxCameraSidePx));
+  if (r.image_height < 1 || r.image_height > kMaxCameraSidePx)
+    fail("image_height", std::to_string(r.image_height) + " px is not in 1-" + std::to_string(kMaxCameraSidePx));
+  const cv::Mat& k = r.camera_matrix;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      if (!std::isfinite(k.at<double>(i, j)))
+        fail("camera_matrix",
+             "element (" + std::to_string(i) + ", " + std::to_string(j) + ") is " + text(k.at<double>(i, j)));
+    }
+  }
+  if (k.at<double>(1, 0) != 0.0 || k.at<double>(2, 0) != 0.0 || k.at<double>(2, 1) != 0.0 || k.at<double>(2, 2) != 1.0)
+    fail("camera_matrix", "is not a camera matrix (its last row must be 0 0 1, and K(1,0) 0)");
+  // A focal length is positive and, in pixels, not far beyond the image: 100 × the longer side is a
+  // 0.5° field of view.
+  const double max_f = 100.0 * std::max(r.image_width, r.image_height);
+  for (const auto& [name, f] : {std::pair<const char*, double>{"fx", k.at<double>(0, 0)}, {"fy", k.at<double>(1, 1)}}) {
+    if (!(f > 0.0 && f <= max_f)) {
+      fail("camera_matrix", std::string(name) + " = " + text(f) + " is not a focal length (0 < " + name +
+                                " <= " + std::to_string(static_cast<long long>(max_f)) + " px)");
+    }
+  }
+  cv::Mat& d = r.distortion;
+  if (!d.empty()) {
+    if ((d.rows != 1 && d.cols != 1) || (d.type() != CV_64F && d.type() != CV_32F))
+      fail("distortion_coefficients", "is not a row or column of numbers");
+    d.convertTo(d, CV_64F);
+    d = d.reshape(1, 1);
+  }
+  const int n = static_cast<int>(d.total());
+  if (n != 0 && n != 4 && n != 5 && n != 8 && n != 12 && n != 14) {
+    fail("distortion_coefficients", "has " + std::to_string(n) + " values; OpenCV takes 4, 5, 8, 12 or 14");
+  }
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(d.at<double>(0, i)) || std::abs(d.at<double>(0, i)) > 1e6) {
+      fail("distortion_coefficients", "value " + std::to_string(i) + " is " + text(d.at<double>(0, i)));
+    }
+  }
+}
+
 CalibrationResult ReadCameraYaml(const std::string& path) {
   RequireReadableFile(path);  // "no such file", "permission denied", … before OpenCV says less
   try {
@@ -150,6 +196,7 @@ CalibrationResult ReadCameraYaml(const std::string& path) {
     need("distortion_coefficients") >> r.distortion;
     if (r.camera_matrix.rows != 3 || r.camera_matrix.cols != 3 || r.camera_matrix.type() != CV_64F)
       throw std::runtime_error(path + ": camera_matrix is not a 3 x 3 matrix of doubles");
+    ValidateCamera(r, path);
     if (!fs["avg_reprojection_error"].empty()) fs["avg_reprojection_error"] >> r.avg_error_px;
     r.calibrated = true;
     return r;

@@ -60,4 +60,13 @@ void WriteCameraYaml(const CalibrationResult& r, const ChessboardOptions& o, con
 // file and key when one is missing.
 CalibrationResult ReadCameraYaml(const std::string& path);
 
+// The largest image side a camera file may give [px].
+constexpr int kMaxCameraSidePx = 16384;
+
+// Refuses a camera that cannot be right, naming `path` and the key: an image size outside
+// 1-kMaxCameraSidePx, a camera matrix with a non-finite element, a last row other than 0 0 1 or a
+// focal length not in (0, 100 × the longer side], distortion that is not 0, 4, 5, 8, 12 or 14 finite
+// values. The distortion comes back as one row of doubles.
+void ValidateCamera(CalibrationResult& r, const std::string& path);
+
 }  // namespace mbot::vision
