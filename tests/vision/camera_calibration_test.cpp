@@ -144,6 +144,14 @@ TEST(CameraCalibrationTest, CamerasThatCannotBeRightAreRefusedNamingTheKey) {
   EXPECT_EQ(error("530.", "0.1, 0., 0.", 3),
             path + ": distortion_coefficients: has 3 values; OpenCV takes 4, 5, 8, 12 or 14");
   EXPECT_EQ(error("530.", zeros, 5, "0"), path + ": image_width: 0 px is not in 1-16384");
+  // Text on which OpenCV 4.6's own YAML parser never returns (found by the camera_yaml fuzz target).
+  std::ofstream(path) << "%YAML:1.\n a:[]\na---\n";
+  try {
+    ReadCameraYaml(path);
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": line 3: 'a---' is not a line of an OpenCV camera file");
+  }
 }
 
 // Grey, BGR and BGRA views all come out as BGR to draw on (a colour camera's views once failed here).

@@ -1,6 +1,7 @@
 #include "mbot/vision/apriltag_detector.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
@@ -122,6 +123,10 @@ std::vector<TagDetection> TagDetector::Detect(const cv::Mat& image) const {
   } else {
     cv::cvtColor(image, gray, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
   }
+  // The reference library reads past a decimated image of fewer than a few rows (a 16 x 1 image
+  // crashes it); no tag fits in one that small anyway.
+  const int min_side = static_cast<int>(std::ceil(8 * options_.decimate));
+  if (gray.cols < min_side || gray.rows < min_side) return {};
   image_u8_t im{gray.cols, gray.rows, static_cast<int32_t>(gray.step[0]), gray.data};
   zarray_t* found = apriltag_detector_detect(impl_->detector, &im);
   std::vector<TagDetection> out;

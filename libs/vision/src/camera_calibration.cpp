@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
 #include <stdexcept>
 
 #include <opencv2/calib3d.hpp>
@@ -179,8 +181,70 @@ void ValidateCamera(CalibrationResult& r, const std::string& path) {
   }
 }
 
+namespace {
+
+// OpenCV 4.6's YAML parser loops forever on some malformed text ("%YAML:1.0\n a:[]\na---\n", found by
+// the camera_yaml fuzz target), so a camera file is checked line by line first: the lines OpenCV's
+// writer makes (a %YAML header, ---, comments, `key: value`, `key: !!opencv-matrix`) and data lines
+// of numbers only. Anything else is refused naming the line.
+void CheckCameraText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  int line_no = 0;
+  size_t total = 0;
+  auto number = [](const std::string& t) {
+    static const char* const kSpecial[] = {".nan", ".NaN", ".NAN", ".inf", ".Inf", ".INF", "-.inf", "-.Inf", "-.INF"};
+    for (const char* s : kSpecial) {
+      if (t == s) return true;
+    }
+    char* end = nullptr;
+    std::strtod(t.c_str(), &end);
+    return !t.empty() && end == t.c_str() + t.size();
+  };
+  while (std::getline(in, line)) {
+    ++line_no;
+    total += line.size() + 1;
+    if (total > (1u << 20)) throw std::runtime_error(path + ": larger than 1 MiB: not a camera file");
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const size_t first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    const std::string t = line.substr(first);
+    if ((line_no == 1 && t.rfind("%YAML", 0) == 0) || t == "---") continue;
+    const size_t colon = t.find(':');
+    const bool key = colon != std::string::npos && colon > 0 &&
+                     t.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") == colon;
+    std::string rest = key ? t.substr(colon + 1) : t;
+    if (key && rest.find("!!opencv-matrix") != std::string::npos) continue;
+    // A value or a data line: numbers, with the brackets and commas of a sequence, or a word value
+    // (dt: d, a calibration's date).
+    bool ok = true;
+    std::string token;
+    int words = 0;
+    for (size_t i = 0; i <= rest.size(); ++i) {
+      const char c = i < rest.size() ? rest[i] : ' ';
+      if (c == ' ' || c == '\t' || c == ',' || c == '[' || c == ']') {
+        if (!token.empty() && !number(token)) {
+          ok = key && token.find_first_of("-:[]{}") == std::string::npos;
+          ++words;
+        }
+        if (!ok) break;
+        token.clear();
+      } else {
+        token += c;
+      }
+    }
+    if (!ok || (!key && words > 0) || (key && rest.find_first_of("{}\"'") != std::string::npos)) {
+      throw std::runtime_error(path + ": line " + std::to_string(line_no) + ": '" + t.substr(0, 80) +
+                               "' is not a line of an OpenCV camera file");
+    }
+  }
+}
+
+}  // namespace
+
 CalibrationResult ReadCameraYaml(const std::string& path) {
   RequireReadableFile(path);  // "no such file", "permission denied", … before OpenCV says less
+  CheckCameraText(path);
   try {
     cv::FileStorage fs(path, cv::FileStorage::READ);
     if (!fs.isOpened()) throw std::runtime_error(path + ": cannot be read as an OpenCV YAML/XML file");
@@ -192,8 +256,23 @@ CalibrationResult ReadCameraYaml(const std::string& path) {
     };
     need("image_width") >> r.image_width;
     need("image_height") >> r.image_height;
-    need("camera_matrix") >> r.camera_matrix;
-    need("distortion_coefficients") >> r.distortion;
+    // An !!opencv-matrix is checked before OpenCV reads it: its parser sizes the matrix from `rows`
+    // and `cols` as they come (a 'rows: u' asked for gigabytes).
+    auto matrix = [&](const char* key, int max_elements, cv::Mat* m) {
+      const cv::FileNode n = need(key);
+      const cv::FileNode rows = n["rows"], cols = n["cols"], data = n["data"];
+      if (!n.isMap() || !rows.isInt() || !cols.isInt() || !data.isSeq())
+        throw std::runtime_error(path + ": " + key + ": not an !!opencv-matrix with integer rows and cols and data");
+      const int nr = static_cast<int>(rows), nc = static_cast<int>(cols);
+      if (nr < 0 || nc < 0 || nr * static_cast<long long>(nc) > max_elements || data.size() != size_t(nr) * nc) {
+        throw std::runtime_error(path + ": " + key + ": " + std::to_string(nr) + " x " + std::to_string(nc) + " with " +
+                                 std::to_string(data.size()) + " values (at most " + std::to_string(max_elements) +
+                                 ", and rows x cols of them)");
+      }
+      n >> *m;
+    };
+    matrix("camera_matrix", 9, &r.camera_matrix);
+    matrix("distortion_coefficients", 14, &r.distortion);
     if (r.camera_matrix.rows != 3 || r.camera_matrix.cols != 3 || r.camera_matrix.type() != CV_64F)
       throw std::runtime_error(path + ": camera_matrix is not a 3 x 3 matrix of doubles");
     ValidateCamera(r, path);
