@@ -592,6 +592,53 @@ TEST(SimWorld, CratesAndStacksThatCannotBeRightAreRefused) {
                                     "a.arena"));
 }
 
+// A nav2 map_saver map as a world: never-mapped grey 205 is wall, not floor (map_server's own rule
+// with free_thresh 0.25 reads it as free); a world without a start pose starts where it has the most
+// room; the floor the body reaches does not leak through a gap narrower than the robot.
+TEST(SimWorld, MapSaverMapsKeepUnknownOutAndTheBodyStaysInside) {
+  // 40 x 30 px at 0.05 m: a room of 254 (free) in 205 (unknown), walls of 0 with a 2-px gap on the
+  // east wall onto more 254 outside.
+  const int w = 40, h = 30;
+  std::vector<uint8_t> px(w * h, 205);
+  auto set = [&](int x, int y, uint8_t v) { px[static_cast<size_t>(h - 1 - y) * w + x] = v; };
+  for (int y = 5; y <= 24; ++y) {
+    for (int x = 5; x <= 24; ++x) set(x, y, (x == 5 || x == 24 || y == 5 || y == 24) ? 0 : 254);
+  }
+  for (int y = 5; y <= 24; ++y) {
+    for (int x = 25; x <= 35; ++x) set(x, y, 254);  // floor outside the room, seen through the gap
+  }
+  set(24, 14, 254), set(24, 15, 254);  // the gap: 0.1 m, narrower than the robot
+  const std::string dir = ::testing::TempDir() + "/saver_map";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream pgm(dir + "/room.pgm", std::ios::binary);
+    pgm << "P5\n" << w << " " << h << "\n255\n";
+    pgm.write(reinterpret_cast<const char*>(px.data()), static_cast<std::streamsize>(px.size()));
+    std::ofstream(dir + "/room.yaml") << "image: room.pgm\nmode: trinary\nresolution: 0.05\norigin: [0, 0, 0]\n"
+                                         "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.25\n";
+  }
+  EXPECT_EQ(mbot::drivers::ReadRosMap(dir + "/room.yaml").at(2, 2) < 0, true);  // map_server's reading: free
+  const World world = World::Load(dir + "/room.yaml");
+  const auto& g = world.truth();
+  EXPECT_GE(g.at(2, 2), 0);    // 205: wall
+  EXPECT_LT(g.at(10, 10), 0);  // 254: floor
+  // The most room: the middle of the room (0.75 m from every wall), the same for the same seed.
+  const motion::Pose2D p = MostRoomPose(world, 3);
+  EXPECT_NEAR(p.x, 0.75, 0.06);
+  EXPECT_NEAR(p.y, 0.75, 0.06);
+  EXPECT_EQ(MostRoomPose(world, 3).theta, p.theta);
+  // Free-cell flooding leaks through the 0.1 m gap; the robot's body (radius 0.1 m) does not.
+  int outside_cell, y_cell;
+  g.WorldToCell(1.5, 0.75, &outside_cell, &y_cell);
+  const size_t outside = static_cast<size_t>(y_cell) * g.width() + outside_cell;
+  EXPECT_TRUE(ReachableFreeMask(world, p)[outside]);
+  const std::vector<uint8_t> body = BodyReachableMask(world, p, 0.1);
+  EXPECT_FALSE(body[outside]);
+  int inside_cell;
+  g.WorldToCell(0.375, 0.375, &inside_cell, &y_cell);  // by a corner of the room, within the body's reach
+  EXPECT_TRUE(body[static_cast<size_t>(y_cell) * g.width() + inside_cell]);
+}
+
 // Sizes that would take gigabytes or minutes are refused or stay cheap.
 TEST(SimWorld, HugeArenasAreRefusedAndLongWallsLoadAlongTheirLength) {
   // 0.005 m over a 99 m box: 392 M cells (1.5 GB before), refused naming the resolution's line.

@@ -151,6 +151,11 @@ static StageType RefereeStageType() {
                                  {"warehouse", sim::CompetitionEvent::kWarehouse},
                                  {"heavy_lift", sim::CompetitionEvent::kHeavyLift}},
                                 "which event is scored");
+            r.robot_radius_m = s.GetDouble(
+                "robot_radius_m", r.robot_radius_m,
+                "the floor to map is what a body of this radius reaches from the start (the simulated MBot's "
+                "footprint_radius_m) [m]",
+                0.01, 2.0);
             r.time_limit_s =
                 s.GetDouble("time_limit_s", r.time_limit_s, "the run ends here if the mission has not [s]", 1.0, 1e5);
             r.finish_delay_s = s.GetDouble("finish_delay_s", r.finish_delay_s,

@@ -138,7 +138,7 @@ void WriteBotlabMap(const msgs::OccupancyGrid& g, const std::string& path) {
   });
 }
 
-msgs::OccupancyGrid ReadRosMap(const std::string& yaml_path) {
+msgs::OccupancyGrid ReadRosMap(const std::string& yaml_path, bool saver_unknown) {
   std::ifstream in(yaml_path);
   if (!in) Fail(yaml_path, "cannot open map YAML");
   std::string image;
@@ -204,6 +204,7 @@ msgs::OccupancyGrid ReadRosMap(const std::string& yaml_path) {
   if (img.empty()) Fail(img_path.string(), "cannot read map image (named in " + yaml_path + ")");
   CheckDeclaredCells(img_path.string(), "image width x height", img.cols, img.rows, 0.0);
   msgs::OccupancyGrid grid(img.cols, img.rows, res, ox, oy);
+  const bool saver_grey = saver_unknown && mode == "trinary" && !negate;  // map_saver writes negate: 0
   for (int r = 0; r < img.rows; ++r) {
     const uint8_t* row = img.ptr<uint8_t>(r);
     const int y = img.rows - 1 - r;
@@ -211,7 +212,9 @@ msgs::OccupancyGrid ReadRosMap(const std::string& yaml_path) {
       const int p = negate ? 255 - row[x] : row[x];
       const double occ = (255.0 - p) / 255.0;
       int8_t v = 0;
-      if (occ > occ_th)
+      if (saver_grey && row[x] == 205)
+        v = 0;  // map_saver's unknown
+      else if (occ > occ_th)
         v = static_cast<int8_t>(std::clamp(127 - p, 1, 127));
       else if (occ < free_th)
         v = static_cast<int8_t>(std::clamp(127 - p, -127, -1));
@@ -426,14 +429,14 @@ bool IsMapFile(const std::string& path) {
   return false;
 }
 
-msgs::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format) {
+msgs::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format, bool saver_unknown) {
   RequireReadableFile(path);
   auto set = [&](const char* f) {
     if (format) *format = f;
   };
   if (EndsWith(path, ".yaml") || EndsWith(path, ".yml")) {
     set("ROS map_server (PGM + YAML)");
-    return ReadRosMap(path);
+    return ReadRosMap(path, saver_unknown);
   }
   if (EndsWith(path, ".gridmap") || EndsWith(path, ".gridmap.gz")) {
     set("MRPT gridmap");

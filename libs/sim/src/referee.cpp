@@ -61,11 +61,11 @@ int PosePoints(const PoseError& e) {
 
 int LapPoints(double s) { return s < 15 ? 100 : s < 20 ? 75 : s < 30 ? 50 : 0; }
 
-ReachableCells FindReachableCells(const World& world, const Pose2D& start) {
+ReachableCells FindReachableCells(const World& world, const Pose2D& start, double robot_radius_m) {
   ReachableCells r;
   r.start = start;
   const mapping::OccupancyGrid& truth = world.truth();
-  const std::vector<uint8_t> reach = ReachableFreeMask(world, start);
+  const std::vector<uint8_t> reach = BodyReachableMask(world, start, robot_radius_m);
   for (int cy = 0; cy < truth.height(); ++cy) {
     for (int cx = 0; cx < truth.width(); ++cx) {
       if (!reach[static_cast<size_t>(cy) * truth.width() + cx]) continue;
@@ -252,7 +252,7 @@ Score Referee::Judge() const {
         {"final pose", Errors(e) + " from the start" + (home ? "" : " (not completed)"), home ? PosePoints(e) : 0});
     if (map_ && (!reachable_ || reachable_->start.x != s.start.x || reachable_->start.y != s.start.y ||
                  reachable_->start.theta != s.start.theta)) {
-      reachable_ = FindReachableCells(world_, s.start);
+      reachable_ = FindReachableCells(world_, s.start, o_.robot_radius_m);
     }
     const MapQuality mq = map_ ? Quality(world_, *map_, *reachable_) : MapQuality{};
     s.map = mq;

@@ -27,10 +27,17 @@ motion::Pose2D StartPose(const SourceOptions& options, const SimSourceOptions& s
     }
   }
   const std::vector<motion::Pose2D> starts = world.PosesLabelled("start");
-  if (starts.empty()) {
-    throw std::runtime_error(options.path + ": the world has no 'start' pose; set [source] start = x, y, theta_deg");
+  if (!starts.empty()) return starts.front();
+  // A map has no start pose: the free pose with the most room (set [source] start to choose one).
+  try {
+    const motion::Pose2D p = MostRoomPose(world, options.seed);
+    mbot::log::Info("sim: " + options.path + " has no start pose; starting at the free pose with the most room (" +
+                    std::to_string(p.x) + ", " + std::to_string(p.y) + ", " + std::to_string(p.theta * 180 / M_PI) +
+                    " deg)");
+    return p;
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(options.path + ": " + e.what() + "; set [source] start = x, y, theta_deg");
   }
-  return starts.front();
 }
 
 std::unique_ptr<SimRobot> MakeRobot(const SourceOptions& options, const SimSourceOptions& sim, World& world,
@@ -143,7 +150,7 @@ void RegisterSimSource() {
        "the simulated MBot on a world (.arena, or a map whose unknown and occupied cells are walls); its keys "
        "are the simulator's",
        [](const std::string& path) { return EndsWith(path, ".arena"); }, 0,
-       [](config::Section& s, SourceOptions* o) { o->extra = ParseSimSourceOptions(s, o->path); },
+       [](config::Section& s, SourceOptions* o) { o->extra = ParseSimSourceOptions(s); },
        [](const SourceOptions& o) -> std::unique_ptr<msgs::Source> {
          const auto* sim = std::any_cast<SimSourceOptions>(&o.extra);
          return std::make_unique<SimSource>(o, sim ? *sim : SimSourceOptions{});

@@ -12,15 +12,15 @@
 
 namespace mbot::sim {
 
-SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& world_path) {
+SimSourceOptions ParseSimSourceOptions(config::Section& s) {
   // Every key is documented as the simulator's: they exist only when the source is the simulator.
   const auto doc = [](const std::string& text) { return std::string("simulator: ") + text; };
   SimSourceOptions o;
   const std::vector<std::string> start =
       s.GetList("start", {},
                 doc("where the robot starts, in the world frame: x [m], y [m], theta [deg], or 'random' "
-                    "(a seeded draw from the reachable free space); default: the arena's 'start' pose "
-                    "(required for a map world)"));
+                    "(a seeded draw from the reachable free space); default: the arena's 'start' pose, or in a "
+                    "world without one (a map) the free pose with the most room"));
   o.random_start_clearance_m = s.GetDouble("random_start_clearance_m", o.random_start_clearance_m,
                                            doc("start = random keeps this far from every wall [m]"), 0.0, 10.0);
   if (start.size() == 1 && start[0] == "random") {
@@ -31,8 +31,6 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s, const std::string& wo
              "expected x, y, theta_deg (3 numbers) or 'random', got " + std::to_string(start.size()) + " items");
     const config::PoseValue p = s.GetPose("start", {}, "");
     o.start = motion::Pose2D{p.x_m, p.y_m, motion::WrapAngle(p.theta_rad)};
-  } else if (!s.describing() && !EndsWith(world_path, ".arena")) {
-    s.Fail("start", "required: the world '" + world_path + "' is a map, which names no start pose");
   }
   o.duration_s =
       s.GetDouble("duration_s", o.duration_s, doc("simulated time after which the run ends [s]"), 0.001, 1e6);

@@ -527,6 +527,63 @@ std::vector<uint8_t> ReachableFreeMask(const World& world, const motion::Pose2D&
   return mask;
 }
 
+std::vector<uint8_t> BodyReachableMask(const World& world, const motion::Pose2D& start, double radius_m) {
+  const auto& g = world.truth();
+  int sx, sy;
+  g.WorldToCell(start.x, start.y, &sx, &sy);
+  if (!g.IsInside(sx, sy) || g.at(sx, sy) >= 0) {
+    throw std::runtime_error("BodyReachableMask: start (" + Num(start.x) + ", " + Num(start.y) +
+                             ") is not in a free cell of the true map of '" + world.name() + "'");
+  }
+  const int w = g.width(), h = g.height();
+  // Where the centre may be: free cells with room for the body (the start's cell always).
+  std::vector<uint8_t> roomy(g.cells().size(), 0);
+  for (int j = 0; j < h; ++j) {
+    for (int i = 0; i < w; ++i) {
+      if (g.at(i, j) >= 0) continue;
+      double x, y;
+      g.CellToWorld(i, j, &x, &y);
+      roomy[static_cast<size_t>(j) * w + i] = world.ClearanceAt(x, y) >= radius_m;
+    }
+  }
+  roomy[static_cast<size_t>(sy) * w + sx] = 1;
+  std::vector<uint8_t> centre(g.cells().size(), 0);
+  std::vector<int> stack{sy * w + sx};
+  centre[stack.back()] = 1;
+  while (!stack.empty()) {
+    const int c = stack.back();
+    stack.pop_back();
+    const int cx = c % w, cy = c / w;
+    const int nx[4] = {cx + 1, cx - 1, cx, cx};
+    const int ny[4] = {cy, cy, cy + 1, cy - 1};
+    for (int k = 0; k < 4; ++k) {
+      if (nx[k] < 0 || ny[k] < 0 || nx[k] >= w || ny[k] >= h) continue;
+      const int n = ny[k] * w + nx[k];
+      if (!centre[n] && roomy[n]) {
+        centre[n] = 1;
+        stack.push_back(n);
+      }
+    }
+  }
+  // The body: free cells within the radius of a centre cell (the centre's clearance keeps the disc
+  // free of walls, so nothing behind a wall is reached).
+  cv::Mat not_centre(h, w, CV_8U);
+  for (int j = 0; j < h; ++j) {
+    for (int i = 0; i < w; ++i) not_centre.at<uint8_t>(j, i) = centre[static_cast<size_t>(j) * w + i] ? 0 : 255;
+  }
+  cv::Mat dist;
+  cv::distanceTransform(not_centre, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  const double reach_cells = radius_m / g.resolution() + 0.5;
+  std::vector<uint8_t> body(g.cells().size(), 0);
+  for (int j = 0; j < h; ++j) {
+    const float* row = dist.ptr<float>(j);
+    for (int i = 0; i < w; ++i) {
+      body[static_cast<size_t>(j) * w + i] = g.at(i, j) < 0 && row[i] <= reach_cells;
+    }
+  }
+  return body;
+}
+
 namespace {
 
 // The world's reachable free space as a mask over its true map (every free cell without a start).
@@ -595,6 +652,33 @@ motion::Pose2D RandomFreePose(const World& world, double clearance_m, uint64_t s
   }
   throw std::runtime_error("RandomFreePose: no place in '" + world.name() + "' keeps " + Num(clearance_m) +
                            " m from every wall (10,000 draws)");
+}
+
+motion::Pose2D MostRoomPose(const World& world, uint64_t seed) {
+  const mapping::OccupancyGrid& t = world.truth();
+  double best = 0.0;
+  std::vector<std::pair<double, int>> room;  // clearance, cell
+  for (int j = 0; j < t.height(); ++j) {
+    for (int i = 0; i < t.width(); ++i) {
+      if (t.at(i, j) >= 0) continue;
+      double x, y;
+      t.CellToWorld(i, j, &x, &y);
+      const double c = world.ClearanceAt(x, y);
+      if (c < best - 0.5 * t.resolution()) continue;
+      best = std::max(best, c);
+      room.emplace_back(c, j * t.width() + i);
+    }
+  }
+  std::vector<int> widest;
+  for (const auto& [c, cell] : room) {
+    if (c >= best - 0.5 * t.resolution()) widest.push_back(cell);
+  }
+  if (widest.empty() || !(best > 0.0)) throw std::runtime_error("'" + world.name() + "' has no free cell to start in");
+  std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ULL + 0x5747A27);
+  const int cell = widest[std::uniform_int_distribution<size_t>(0, widest.size() - 1)(rng)];
+  double x, y;
+  t.CellToWorld(cell % t.width(), cell / t.width(), &x, &y);
+  return {x, y, std::uniform_real_distribution<double>(-M_PI, M_PI)(rng)};
 }
 
 void PlaceCratesAtRandom(World* world, const CrateArea& area, uint64_t seed, const motion::Pose2D& keep_clear,

@@ -42,7 +42,8 @@ World World::Load(const std::string& path) {
   if (HasArenaExtension(path)) {
     w = ParseArena(ReadText(path), path);
   } else {
-    const mapping::OccupancyGrid grid = drivers::ReadAnyMap(path);  // names the file itself
+    // Names the file itself. What was never mapped is no floor: map_saver's grey 205 is unknown (a wall).
+    const mapping::OccupancyGrid grid = drivers::ReadAnyMap(path, nullptr, /*saver_unknown=*/true);
     try {
       w = FromGrid(grid);
     } catch (const std::exception& e) {

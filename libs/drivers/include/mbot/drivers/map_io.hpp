@@ -28,7 +28,10 @@ void WriteBotlabMap(const msgs::OccupancyGrid& grid, const std::string& path);
 // as map_server does; occupied and free cells keep a graded log-odds from the pixel value.
 // Written maps use pixel = 127 - log-odds with thresholds that split at log-odds 0, so a
 // botlab grid survives the round trip exactly.
-msgs::OccupancyGrid ReadRosMap(const std::string& yaml_path);
+// `saver_unknown`: a trinary map's pixel 205 (negate 0, as map_saver writes) is unknown whatever the thresholds say.
+// nav2's map_saver writes never-mapped cells as 205 with free_thresh 0.25, which map_server's own
+// rule ((255 - 205) / 255 = 0.196 < 0.25) reads back as free: floor nobody saw.
+msgs::OccupancyGrid ReadRosMap(const std::string& yaml_path, bool saver_unknown = false);
 void WriteRosMap(const msgs::OccupancyGrid& grid, const std::string& yaml_path);
 
 // MRPT COccupancyGridMap2D serialised with CArchive (optionally gzip-compressed). MRPT cells hold
@@ -68,7 +71,7 @@ void WriteOctomap(const msgs::OccupancyGrid& grid, double wall_height_m, const s
 bool IsMapFile(const std::string& path);
 
 // Reads any of the formats above, chosen by extension and content (simplemaps at 0.05 m).
-msgs::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format = nullptr);
+msgs::OccupancyGrid ReadAnyMap(const std::string& path, std::string* format = nullptr, bool saver_unknown = false);
 
 // A SLAM checkpoint, so an autonomy killed mid-run starts again from what it had mapped: the map as a
 // botlab .map beside an INI file ([checkpoint] map, pose and odometry = x, y, theta_deg, t_s, scans). The map is

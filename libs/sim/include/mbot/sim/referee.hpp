@@ -34,6 +34,10 @@ struct RefereeOptions {
   double time_limit_s = 180.0;  // the run ends here if the mission has not
   double finish_delay_s = 0.5;  // keep simulating this long after the mission ends (the robot stops)
   int crates = 0;               // Heavy Lift: judge only the world's first this many stack assignments (0: all)
+  // The floor to be mapped is what the robot's body reaches: cells within this radius of a place
+  // the robot's centre can get to from the start (keeping this radius from every wall). A gap
+  // narrower than the robot (in a map world's walls, say) does not open the space behind it.
+  double robot_radius_m = 0.1;
 };
 
 // One line of the rubric: what was judged, how it went, the points.
@@ -106,7 +110,7 @@ struct ReachableCells {
   motion::Pose2D start;
   std::vector<double> x, y, clearance;  // world frame [m]
 };
-ReachableCells FindReachableCells(const World& world, const motion::Pose2D& start);
+ReachableCells FindReachableCells(const World& world, const motion::Pose2D& start, double robot_radius_m);
 // The map (in the frame of `reachable.start`) against the world: coverage of the reachable free
 // space and precision of the walls.
 MapQuality Quality(const World& world, const mapping::OccupancyGrid& map, const ReachableCells& reachable);

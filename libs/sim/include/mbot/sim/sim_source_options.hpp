@@ -29,8 +29,7 @@ struct SimSourceOptions {
   SimRobotOptions robot;
 };
 
-// Reads the simulator's keys of [source]. `world_path` (the source's path) decides whether `start`
-// is required. Throws config::ConfigError naming the key.
-SimSourceOptions ParseSimSourceOptions(config::Section& section, const std::string& world_path);
+// Reads the simulator's keys of [source]. Throws config::ConfigError naming the key.
+SimSourceOptions ParseSimSourceOptions(config::Section& section);
 
 }  // namespace mbot::sim

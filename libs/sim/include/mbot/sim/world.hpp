@@ -167,6 +167,12 @@ class World {
 // exploration run is scored. Throws when the start is not in a free cell.
 std::vector<uint8_t> ReachableFreeMask(const World& world, const motion::Pose2D& start);
 
+// The free cells a round robot of `radius_m` starting at `start` can touch: its centre moves through
+// free cells at least `radius_m` from every wall (4-connected, from the start's cell), and every free
+// cell within `radius_m` of a cell its centre reaches is reached by its body. Unlike
+// ReachableFreeMask this does not leak through a gap narrower than the robot.
+std::vector<uint8_t> BodyReachableMask(const World& world, const motion::Pose2D& start, double radius_m);
+
 // The world as a known map at `resolution_m` (a competition's given map, e.g. the Warehouse's):
 // cells whose centre is within half a cell side of a wall are occupied (+127; what a mapped wall
 // looks like, not every cell a wall grazes), cells of the reachable free space (from the world's
@@ -190,6 +196,10 @@ EventInputs EventInputsOf(const World& world);
 // space when it has none) that keeps `clearance_m` from every wall, heading uniform; the same seed
 // gives the same pose. Throws when 10,000 draws find no such place.
 motion::Pose2D RandomFreePose(const World& world, double clearance_m, uint64_t seed);
+
+// Where a world without a start pose starts: the free cell of the true map farthest from any wall
+// (the most room), ties within half a cell broken by `seed`, heading drawn from `seed`.
+motion::Pose2D MostRoomPose(const World& world, uint64_t seed);
 
 // Adds area.count crates of the default size at uniform random positions and headings inside the
 // area's square, each clear of the walls, area.min_gap_m from the other crates and `keep_clear_m` from `keep_clear`
