@@ -21,7 +21,8 @@ Json GraphSlamJson(const mapping::GraphSlamStats& g) {
                   std::to_string(g.loop_searches) + " searches, " + std::to_string(g.rejected.size()) +
                   " rejected by the robust loss; " + std::to_string(g.sparse_scans) + " scans too sparse to match; " +
                   std::to_string(g.recoveries) + " scans placed by a recovery search (of " +
-                  std::to_string(g.recovery_searches) + "); " + std::to_string(g.degenerate_scans) +
+                  std::to_string(g.recovery_searches) + ", " + std::to_string(g.doubtful_searches) +
+                  " for odometry gaps or restarts); " + std::to_string(g.degenerate_scans) +
                   " scans moved by odometry along a corridor");
   for (size_t i = 0; i < g.rejected.size() && i < 5; ++i) {
     const mapping::RejectedClosure& r = g.rejected[i];
@@ -40,6 +41,7 @@ Json GraphSlamJson(const mapping::GraphSlamStats& g) {
           {"sparse_scans", g.sparse_scans},
           {"recovery_searches", g.recovery_searches},
           {"recoveries", g.recoveries},
+          {"doubtful_searches", g.doubtful_searches},
           {"degenerate_scans", g.degenerate_scans},
           {"loop_searches", g.loop_searches},
           {"loop_closures", g.loop_closures},

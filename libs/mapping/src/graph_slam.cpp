@@ -56,7 +56,7 @@ void GraphSlam::Initialize(const Pose2D& pose, const Pose2D& odometry) {
   initialized_ = true;
 }
 
-Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& odometry) {
+Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& odometry, bool odometry_doubtful) {
   if (!initialized_) throw std::logic_error("graph SLAM: ProcessScan before Initialize");
   MaybeApplyFinished();
   const auto t0 = Clock::now();
@@ -79,9 +79,12 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
     Pose2D start = local;
     if (options_.local_search) {
       MatchResult m = MatchBranchAndBound(*s.field, *points, local, options_.local_window, 0.0);
-      if (options_.recover_below > 0 && scores_ >= 20 && (!m.found || m.score < options_.recover_below * mean_score_)) {
-        // The odometry's prior does not fit the map: look where the robot could be.
+      const bool poor = !m.found || m.score < options_.recover_below * mean_score_;
+      if (options_.recover_below > 0 && scores_ >= 20 && (poor || (odometry_doubtful && options_.recover_gap_s > 0))) {
+        // The odometry's prior does not fit the map, or the odometry itself is doubtful: look where
+        // the robot could be.
         ++stats_.recovery_searches;
+        if (!poor) ++stats_.doubtful_searches;
         if (!s.wide) {
           s.wide = std::make_shared<const MatchGrid>(
               s.grid->map(), options_.field_sigma_m, options_.occupied_threshold,

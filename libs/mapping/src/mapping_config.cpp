@@ -167,6 +167,10 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
                         "front end: a fit below this share of the running mean score is searched again over the "
                         "recovery window (0: never)",
                         0.0, 1.0);
+  g.recover_gap_s = num("recover_gap_s", g.recover_gap_s,
+                        "front end: an odometry gap longer than this around a scan, or a zeroed restart, searches the "
+                        "recovery window whatever the fit scored (0: never)",
+                        0.0, 3600.0);
   g.recover_window.linear_m =
       num("recover_window_m", g.recover_window.linear_m, "front end: recovery search window, +-", 0.0, 20.0);
   g.recover_window.angular_rad =

@@ -69,11 +69,11 @@ void Slam::InitializeGlobal(const motion::Pose2D& odometry) {
 }
 
 SlamStep Slam::ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2D& odometry,
-                           const motion::Pose2D* reference) {
+                           const motion::Pose2D* reference, bool odometry_doubtful) {
   if (!initialized_) throw std::logic_error("SLAM: ProcessScan before Initialize");
   SlamStep out;
   if (graph_) {
-    out.pose = graph_->ProcessScan(rays, odometry);
+    out.pose = graph_->ProcessScan(rays, odometry, odometry_doubtful);
     out.filter_updated = true;
     return out;
   }

@@ -250,12 +250,28 @@ void SlamInputs::AddOdometry(int64_t t_us, const Pose2D& raw) {
                         "dropped; further ones are counted");
   }
   if (continuity_.restarts() > restarts) {
+    restart_times_.push_back(continuity_.last_restart_us());
+    if (restart_times_.size() > 64) restart_times_.pop_front();
     mbot::log::Warn("slam: odometry jumped by more than a robot can move at " +
                     std::to_string((t_us - first_t_us_) * 1e-6) +
                     " s (a robot restart?): continuing from the pose before the jump");
   }
   const Pose2D out = perturbation_.Apply(t_us, first_t_us_, continuous);
   odometry_.push_back({t_us, out});
+}
+
+bool SlamInputs::PosesDoubtful(int64_t from_us, int64_t to_us, int64_t max_gap_us) const {
+  for (const int64_t r : restart_times_) {
+    if (r > from_us && r <= to_us) return true;
+  }
+  const std::vector<TimedPose>& series = poses();
+  auto k =
+      std::lower_bound(series.begin(), series.end(), from_us, [](const TimedPose& p, int64_t t) { return p.t_us < t; });
+  if (k != series.begin()) --k;
+  for (; k != series.end() && k + 1 != series.end() && k->t_us <= to_us; ++k) {
+    if ((k + 1)->t_us - k->t_us > max_gap_us) return true;
+  }
+  return false;
 }
 
 void SlamInputs::TrimBefore(int64_t t_us) {
@@ -348,7 +364,12 @@ void SlamSession::ProcessScan(const SlamInputs::Scan& p, int64_t t_end, std::vec
     return;
   }
   const bool mapping_only = o_.slam.mode == SlamMode::kMappingOnly;
-  const SlamStep step = slam_.ProcessScan(rays, end_pose, mapping_only ? &end_pose : nullptr);
+  // Graph SLAM searches widely where the odometry since the last scan crossed a gap or a restart.
+  const double gap_s = o_.slam.graph.recover_gap_s;
+  const bool doubtful = o_.slam.mode == SlamMode::kGraphSlam && gap_s > 0 && last_scan_end_us_ >= 0 &&
+                        inputs_.PosesDoubtful(last_scan_end_us_, t_end, static_cast<int64_t>(gap_s * 1e6));
+  last_scan_end_us_ = t_end;
+  const SlamStep step = slam_.ProcessScan(rays, end_pose, mapping_only ? &end_pose : nullptr, doubtful);
   if (scan_sample_.Wants(records_.size())) scan_sample_.Add(records_.size(), consistency_model_.Prepare(rays));
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall0).count();
 

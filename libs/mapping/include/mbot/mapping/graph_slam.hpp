@@ -46,6 +46,10 @@ struct GraphSlamOptions {
   // over `recover_window`; a pose found there that scores above that bound and better than the
   // local one is kept, and the odometry constraint to the next node is then left out (0: never).
   double recover_below = 0.75;
+  // Where the odometry itself says it is doubtful — a gap longer than this between the odometry
+  // readings around a scan, or a restart the continuity check zeroed — the recovery window is
+  // searched whatever the local fit scored (the same acceptance rule; 0: only on a poor fit).
+  double recover_gap_s = 1.0;
   // A scan that cannot pin its position down along a direction (its surfaces' weakest information
   // below this share of their strongest, ScanTranslationConstraint: a corridor) keeps odometry's
   // motion along it; the fit would put it where the submap's walls end (0: trust the fit).
@@ -80,9 +84,9 @@ struct RejectedClosure {
 
 struct GraphSlamStats {
   int scans = 0, nodes = 0, submaps = 0, sparse_scans = 0;
-  int recovery_searches = 0, recoveries = 0;
-  int degenerate_scans =
-      0;  // whose motion along a corridor came from odometry  // wide searches made, and those that moved the scan
+  int recovery_searches = 0, recoveries = 0;  // wide searches made, and those that moved the scan
+  int doubtful_searches = 0;                  // of the searches: those the odometry's gap or restart asked for
+  int degenerate_scans = 0;                   // whose motion along a corridor came from odometry
   int64_t loop_searches = 0, loop_closures = 0;
   std::vector<RejectedClosure> rejected;  // by the robust loss, at the last solve
   int optimizations = 0;
@@ -103,7 +107,10 @@ class GraphSlam {
   bool initialized() const { return initialized_; }
   // One scan (rays in the frame of the robot at the scan's end) with the odometry then; returns the
   // scan's pose by the current estimate.
-  motion::Pose2D ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2D& odometry);
+  // `odometry_doubtful`: the odometry since the last scan spans a gap or a restart (see
+  // GraphSlamOptions::recover_gap_s), so its prior is searched around widely.
+  motion::Pose2D ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2D& odometry,
+                             bool odometry_doubtful = false);
   // Waits for the worker, closes the last loops, solves the graph to convergence, renders the map.
   void Finish();
 

@@ -89,8 +89,9 @@ class Slam {
 
   // One scan, its rays in the frame of the robot at the scan's end; `odometry` is the odometry pose
   // at that time; `reference` the externally given pose (mapping-only; ignored otherwise).
+  // `odometry_doubtful` (graph SLAM): the odometry since the last scan crossed a gap or a restart.
   SlamStep ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2D& odometry,
-                       const motion::Pose2D* reference = nullptr);
+                       const motion::Pose2D* reference = nullptr, bool odometry_doubtful = false);
 
   // Graph SLAM: closes the last loops and solves the graph (a no-op in the other modes).
   void Finish();

@@ -102,6 +102,9 @@ class SlamInputs {
   const std::map<std::string, int64_t>& odometry_channels_seen() const { return odometry_seen_; }
   int64_t kidnapped_at_us() const { return perturbation_.kidnapped_at_us(); }
   int odometry_restarts() const { return continuity_.restarts(); }
+  // Whether the poses between `from_us` and `to_us` (with the readings around them) leave a gap
+  // longer than `max_gap_us`, or the odometry restarted (a zeroed jump) in (from_us, to_us].
+  bool PosesDoubtful(int64_t from_us, int64_t to_us, int64_t max_gap_us) const;
 
   // Drops the pose series' entries before t_us, keeping the last one before it (an interpolation
   // at t_us still has both neighbours), so a run of any length keeps bounded memory. Cheap to call
@@ -125,7 +128,8 @@ class SlamInputs {
   int64_t previous_scan_us_ = -1;
   int64_t scans_seen_ = 0;
   std::map<std::string, int64_t> odometry_seen_;
-  long long stamp_outliers_ = 0;  // stamps far from their arrival, placed at the arrival instead
+  long long stamp_outliers_ = 0;       // stamps far from their arrival, placed at the arrival instead
+  std::deque<int64_t> restart_times_;  // the last restarts the continuity check zeroed, oldest first
   int64_t first_t_us_ = -1, last_t_us_ = -1;
 };
 
@@ -206,6 +210,7 @@ class SlamSession {
   int skipped_scans_ = 0;
   double rss_mb_ = 0;
   int64_t last_checkpoint_us_ = -1;
+  int64_t last_scan_end_us_ = -1;  // the last scan given to SLAM
   std::function<void(const SlamCheckpointState&, const OccupancyGrid&)> on_checkpoint_;
   bool status_due_ = false, map_due_ = false;  // after a person's SlamControl
 };
