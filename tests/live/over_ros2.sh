@@ -80,5 +80,9 @@ fi
 grep -q '"state": "completed"' "$out/autonomy/mission.json" || { echo "FAIL: the autonomy's mission did not complete"; fail=1; }
 grep -E "^ros2: [0-9.]+ messages/s" "$out/autonomy.log" | tail -1 | grep -q " 0 rejected" ||
   { echo "FAIL: the autonomy rejected messages from the simulated robot"; fail=1; }
+# /reset_odometry: the autonomy called it at start, the simulated robot served it and answered.
+grep -q "^ros2: /reset_odometry: Odometry reset to (0, 0, 0)" "$out/autonomy.log" &&
+  grep -q "^ros2_bridge: /reset_odometry: odometry reset" "$out/robot.log" ||
+  { echo "FAIL: /reset_odometry was not called and answered"; fail=1; }
 [ $fail -eq 0 ] && echo "PASS: $task over ROS 2 (DDS), no collision"
 exit $fail

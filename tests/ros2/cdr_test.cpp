@@ -58,6 +58,34 @@ TEST(Cdr, BadPayloadsNameTheFieldAndOffset) {
   EXPECT_THROW(DecodeTwist(b.data(), 3), CdrError);
 }
 
+// std_srvs/Trigger as it travels: the request alone (one placeholder byte), or with rmw_cyclonedds's
+// 16-byte header (client handle, sequence) in front, which a server echoes in its reply.
+TEST(Cdr, TriggerRequestsAndResponsesInBothForms) {
+  const std::vector<uint8_t> plain = EncodeTriggerRequest();
+  EXPECT_EQ(plain, (std::vector<uint8_t>{0, 1, 0, 0, 0}));
+  ServiceHeader h;
+  EXPECT_FALSE(DecodeTriggerRequest(plain.data(), plain.size(), &h));
+  std::vector<uint8_t> padded = plain;  // as Fast DDS pads it on the wire
+  padded.resize(8, 0);
+  EXPECT_FALSE(DecodeTriggerRequest(padded.data(), padded.size(), &h));
+  const ServiceHeader sent{0x0102030405060708ULL, 42};
+  const std::vector<uint8_t> with = EncodeTriggerRequest(&sent);
+  ASSERT_EQ(with.size(), 21u);
+  EXPECT_TRUE(DecodeTriggerRequest(with.data(), with.size(), &h));
+  EXPECT_EQ(h.guid, sent.guid);
+  EXPECT_EQ(h.sequence, 42);
+  const std::vector<uint8_t> reply = Encode(TriggerResponse{true, "Odometry reset to (0, 0, 0)"});
+  // bool, 3 bytes of padding, the length with the NUL, the text.
+  ASSERT_EQ(reply.size(), 4u + 4 + 4 + 28);
+  EXPECT_EQ(reply[8], 28);
+  const TriggerResponse back = DecodeTriggerResponse(reply.data(), reply.size());
+  EXPECT_TRUE(back.success);
+  EXPECT_EQ(back.message, "Odometry reset to (0, 0, 0)");
+  EXPECT_EQ(Encode(TriggerResponse{true, "x"}, &sent).size(), 4u + 16 + 4 + 4 + 2);
+  const std::vector<uint8_t> cut(reply.begin(), reply.begin() + 10);
+  EXPECT_THROW(DecodeTriggerResponse(cut.data(), cut.size()), CdrError);
+}
+
 TEST(Cdr, YawRoundTrips) {
   EXPECT_NEAR(Yaw(FromYaw(2.5)), 2.5, 1e-12);
   EXPECT_NEAR(Yaw(FromYaw(-3.0)), -3.0, 1e-12);

@@ -4,7 +4,8 @@
 # files), inside a private network namespace (loopback up, multicast on it) so no packet leaves the
 # test. The peer publishes /tf_static, /odom and /scan for 8 s and asserts that a non-zero /cmd_vel
 # comes back, that a late-joining reader gets /map with the room where the mount puts it, and that
-# the autonomy announced its node /mbot_nav on ros_discovery_info with /cmd_vel's writer in it.
+# the autonomy announced its node /mbot_nav on ros_discovery_info with /cmd_vel's writer in it; it serves
+# /reset_odometry as the MBot's micro-ROS agent does, and the autonomy must take its reply.
 #   fastdds_interop.sh <mbot_nav> <mbot_fastdds_peer> <config dir> <output dir>
 set -u
 bin=$1 peer=$2 config=$3 out=$4
@@ -30,4 +31,6 @@ echo "--- Fast DDS peer"; cat "$out/peer.log"
 echo "--- autonomy"; grep -E "ros2|error" "$out/autonomy.log" | tail -6
 [ $rc -eq 0 ] || { echo "FAIL"; exit 1; }
 grep -q "0 rejected" "$out/autonomy.log" || { echo "FAIL: the autonomy rejected messages of the Fast DDS peer"; exit 1; }
+grep -q "ros2: /reset_odometry: Odometry reset to (0, 0, 0)" "$out/autonomy.log" ||
+  { echo "FAIL: the autonomy did not take the peer's /reset_odometry reply"; exit 1; }
 echo PASS

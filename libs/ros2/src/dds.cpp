@@ -265,10 +265,10 @@ DdsParticipant::DdsParticipant(const DdsOptions& options) : impl_(std::make_uniq
 
 DdsParticipant::~DdsParticipant() = default;
 
-int DdsParticipant::AddReader(const std::string& topic, const std::string& type, const Qos& q) {
+int DdsParticipant::AddReader(const std::string& topic, const std::string& type, const Qos& q, bool dds_name) {
   dds_qos_t* qos = QosOf(q);
   dds_qset_ignorelocal(qos, DDS_IGNORELOCAL_PARTICIPANT);  // not our own writers' samples
-  const dds_entity_t r = dds_create_reader(impl_->participant, impl_->Topic(topic, type), qos, nullptr);
+  const dds_entity_t r = dds_create_reader(impl_->participant, impl_->Topic(topic, type, !dds_name), qos, nullptr);
   dds_delete_qos(qos);
   if (r < 0) throw std::runtime_error("dds: reader on " + topic + ": " + dds_strretcode(r));
   const dds_entity_t cond = dds_create_readcondition(r, DDS_ANY_STATE);
@@ -279,10 +279,10 @@ int DdsParticipant::AddReader(const std::string& topic, const std::string& type,
   return static_cast<int>(impl_->readers.size()) - 1;
 }
 
-int DdsParticipant::AddWriter(const std::string& topic, const std::string& type, const Qos& q) {
+int DdsParticipant::AddWriter(const std::string& topic, const std::string& type, const Qos& q, bool dds_name) {
   dds_qos_t* qos = QosOf(q);
   dds_qset_ignorelocal(qos, DDS_IGNORELOCAL_PARTICIPANT);
-  const dds_entity_t w = dds_create_writer(impl_->participant, impl_->Topic(topic, type), qos, nullptr);
+  const dds_entity_t w = dds_create_writer(impl_->participant, impl_->Topic(topic, type, !dds_name), qos, nullptr);
   dds_delete_qos(qos);
   if (w < 0) throw std::runtime_error("dds: writer on " + topic + ": " + dds_strretcode(w));
   impl_->writers.push_back(w);
@@ -297,29 +297,41 @@ bool DdsParticipant::Write(int writer, const uint8_t* cdr, size_t size) {
   return dds_write(impl_->writers[writer], &blob) == DDS_RETCODE_OK;
 }
 
+namespace {
+
+// Every sample waiting on `reader` (index `index`), in batches.
+void TakeAll(dds_entity_t reader, int index, const std::function<void(const DdsParticipant::Sample&)>& on_sample) {
+  constexpr uint32_t kBatch = 16;
+  ddsi_serdata* got[kBatch];
+  dds_sample_info_t info[kBatch];
+  for (;;) {
+    const dds_return_t n = dds_takecdr(reader, got, kBatch, info, DDS_ANY_STATE);
+    if (n <= 0) break;
+    for (dds_return_t k = 0; k < n; ++k) {
+      const auto* s = static_cast<const RawSample*>(got[k]);
+      if (info[k].valid_data && !s->bytes.empty())
+        on_sample({index, s->bytes.data(), s->bytes.size(), info[k].source_timestamp / 1000,
+                   s->arrival_us ? s->arrival_us : msgs::WallClockUs()});
+      ddsi_serdata_unref(got[k]);
+    }
+    if (static_cast<uint32_t>(n) < kBatch) break;
+  }
+}
+
+}  // namespace
+
 void DdsParticipant::Take(int timeout_ms, const std::function<void(const Sample&)>& on_sample) {
   if (impl_->readers.empty()) {
     if (timeout_ms > 0) dds_sleepfor(DDS_MSECS(timeout_ms));
     return;
   }
   if (timeout_ms > 0) dds_waitset_wait(impl_->waitset, nullptr, 0, DDS_MSECS(timeout_ms));
-  constexpr uint32_t kBatch = 16;
-  ddsi_serdata* got[kBatch];
-  dds_sample_info_t info[kBatch];
-  for (size_t i = 0; i < impl_->readers.size(); ++i) {
-    for (;;) {
-      const dds_return_t n = dds_takecdr(impl_->readers[i], got, kBatch, info, DDS_ANY_STATE);
-      if (n <= 0) break;
-      for (dds_return_t k = 0; k < n; ++k) {
-        const auto* s = static_cast<const RawSample*>(got[k]);
-        if (info[k].valid_data && !s->bytes.empty())
-          on_sample({static_cast<int>(i), s->bytes.data(), s->bytes.size(), info[k].source_timestamp / 1000,
-                     s->arrival_us ? s->arrival_us : msgs::WallClockUs()});
-        ddsi_serdata_unref(got[k]);
-      }
-      if (static_cast<uint32_t>(n) < kBatch) break;
-    }
-  }
+  for (size_t i = 0; i < impl_->readers.size(); ++i) TakeAll(impl_->readers[i], static_cast<int>(i), on_sample);
+}
+
+void DdsParticipant::TakeFrom(int reader, int timeout_ms, const std::function<void(const Sample&)>& on_sample) {
+  if (timeout_ms > 0) dds_sleepfor(DDS_MSECS(timeout_ms));
+  TakeAll(impl_->readers.at(reader), reader, on_sample);
 }
 
 int DdsParticipant::MatchedReaders(int writer) const {

@@ -366,4 +366,40 @@ double Yaw(const Quaternion& q) {
 }
 Quaternion FromYaw(double yaw) { return {0.0, 0.0, std::sin(yaw / 2), std::cos(yaw / 2)}; }
 
+std::vector<uint8_t> EncodeTriggerRequest(const ServiceHeader* header) {
+  CdrWriter w;
+  if (header) w.U64(header->guid), w.I64(header->sequence);
+  w.U8(0);  // structure_needs_at_least_one_member
+  return w.bytes();
+}
+
+bool DecodeTriggerRequest(const uint8_t* data, size_t size, ServiceHeader* header) {
+  CdrReader r(data, size);
+  // The placeholder alone (padded to 4 bytes on the wire), or the 16-byte header and it.
+  const bool with_header = r.remaining() >= 17;
+  if (with_header) {
+    const uint64_t guid = r.U64("request_header.guid");
+    const int64_t sequence = r.I64("request_header.sequence");
+    if (header) *header = {guid, sequence};
+  }
+  r.U8("structure_needs_at_least_one_member");
+  return with_header;
+}
+
+std::vector<uint8_t> Encode(const TriggerResponse& m, const ServiceHeader* header) {
+  CdrWriter w;
+  if (header) w.U64(header->guid), w.I64(header->sequence);
+  w.Bool(m.success);
+  w.String(m.message);
+  return w.bytes();
+}
+
+TriggerResponse DecodeTriggerResponse(const uint8_t* data, size_t size) {
+  CdrReader r(data, size);
+  TriggerResponse m;
+  m.success = r.Bool("success");
+  m.message = r.String("message");
+  return m;
+}
+
 }  // namespace mbot::ros2

@@ -1,8 +1,10 @@
 #include "ros2_live.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <stdexcept>
+#include <thread>
 
 #include "mbot/common/config.hpp"
 #include "mbot/common/log.hpp"
@@ -113,8 +115,73 @@ Ros2Node::Ros2Node(Ros2NodeOptions options, const std::vector<std::string>& chan
   decoder_.WaitForMount(o_.wait_for_mount_us);
 }
 
+namespace {
+
+// rmw's service topics: "/reset_odometry" → rq/reset_odometryRequest and rr/reset_odometryReply,
+// reliable and volatile, keep last 10 (rmw_qos_profile_services_default).
+std::string ServiceTopic(const std::string& service, const char* prefix, const char* suffix) {
+  return std::string(prefix) + (service.empty() || service.front() != '/' ? "/" + service : service) + suffix;
+}
+const Qos kServiceQos{10, true, false};
+
+}  // namespace
+
+void Ros2Node::ServeTrigger(const std::string& service, std::function<TriggerResponse()> handler) {
+  const int reader = dds_.AddReader(ServiceTopic(service, "rq", "Request"), kTriggerRequestType, kServiceQos, true);
+  const int writer = dds_.AddWriter(ServiceTopic(service, "rr", "Reply"), kTriggerResponseType, kServiceQos, true);
+  servers_[reader] = {service, writer, std::move(handler)};
+  stats_[service].type = "std_srvs/srv/Trigger";
+}
+
+std::optional<TriggerResponse> Ros2Node::CallTrigger(const std::string& service, int timeout_ms) {
+  const int writer = dds_.AddWriter(ServiceTopic(service, "rq", "Request"), kTriggerRequestType, kServiceQos, true);
+  const int reader = dds_.AddReader(ServiceTopic(service, "rr", "Reply"), kTriggerResponseType, kServiceQos, true);
+  service_readers_.insert(reader);
+  stats_[service].type = "std_srvs/srv/Trigger";
+  const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  // Volatile topics: a request sent before the server's reader matched is lost.
+  while ((dds_.MatchedReaders(writer) == 0 || dds_.MatchedWriters(reader) == 0) &&
+         std::chrono::steady_clock::now() < end)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  if (dds_.MatchedReaders(writer) == 0) return std::nullopt;
+  const std::vector<uint8_t> request = EncodeTriggerRequest();
+  if (!dds_.Write(writer, request.data(), request.size())) return std::nullopt;
+  ++stats_[service].published;
+  std::optional<TriggerResponse> reply;
+  while (!reply && std::chrono::steady_clock::now() < end) {
+    dds_.TakeFrom(reader, 20, [&](const DdsParticipant::Sample& s) {
+      if (reply) return;
+      ++stats_[service].received;
+      try {
+        reply = DecodeTriggerResponse(s.data, s.size);
+      } catch (const std::exception& e) {
+        ++stats_[service].rejected;
+        stats_[service].last_error = e.what();
+      }
+    });
+  }
+  return reply;
+}
+
 void Ros2Node::Poll(int timeout_ms, std::vector<Event>* out) {
   dds_.Take(timeout_ms, [&](const DdsParticipant::Sample& s) {
+    if (service_readers_.count(s.reader)) return;  // a late reply to a call that gave up
+    if (auto server = servers_.find(s.reader); server != servers_.end()) {
+      TopicStats& st = stats_[server->second.service];
+      ++st.received;
+      ServiceHeader header;
+      bool with_header = false;
+      try {
+        with_header = DecodeTriggerRequest(s.data, s.size, &header);
+      } catch (const std::exception& e) {
+        ++st.rejected;
+        st.last_error = e.what();
+        return;
+      }
+      const std::vector<uint8_t> reply = Encode(server->second.handler(), with_header ? &header : nullptr);
+      if (dds_.Write(server->second.reply_writer, reply.data(), reply.size())) ++st.published;
+      return;
+    }
     const Route& r = routes_[s.reader];
     TopicStats& st = stats_[r.wire];
     ++st.received;
@@ -191,9 +258,21 @@ namespace {
 class Ros2Link : public msgs::LiveLink {
  public:
   Ros2Link(Ros2NodeOptions o, const std::vector<std::string>& channels, const msgs::ChannelRoles& roles,
-           const std::string& command_channel)
+           const std::string& command_channel, const std::string& reset_odometry_service)
       : topics_(o.topics), node_(std::move(o), channels, roles) {
     node_.PrepareWriter(topics_.Wire(command_channel), kTwistType);  // discovery before the first command
+    if (!reset_odometry_service.empty()) {
+      // The robot's odometry from zero, as the course's nodes start it (odometry from before the
+      // reset that is still queued reads as a robot restart, which SLAM's continuity check takes).
+      const std::optional<TriggerResponse> r = node_.CallTrigger(reset_odometry_service, kResetTimeoutMs);
+      if (!r) {
+        mbot::log::Warn("ros2: " + reset_odometry_service + " did not answer within " +
+                        std::to_string(kResetTimeoutMs / 1000) + " s; the robot's odometry was not reset");
+      } else {
+        (r->success ? mbot::log::Info : mbot::log::Warn)("ros2: " + reset_odometry_service + ": " +
+                                                         (r->success ? "" : "failed: ") + r->message);
+      }
+    }
   }
   void Poll(int timeout_ms, std::vector<Event>* out) override { node_.Poll(timeout_ms, out); }
   bool Publish(const Event& event) override { return node_.Publish(event); }
@@ -209,6 +288,7 @@ class Ros2Link : public msgs::LiveLink {
   std::vector<std::pair<std::string, std::string>> Details() const override { return node_.Details(); }
 
  private:
+  static constexpr int kResetTimeoutMs = 3000;
   msgs::TopicTable topics_;
   Ros2Node node_;
 };
@@ -219,8 +299,9 @@ std::unique_ptr<msgs::Source> OpenRos2Live(const msgs::SourceOptions& options) {
   Ros2LiveOptions o = msgs::ExtraOr<Ros2LiveOptions>(options);
   o.node.dds.domain_id = ParseDomain(options.path.empty() ? "dds:0" : options.path);
   return std::make_unique<msgs::LiveSource>(
-      std::make_unique<Ros2Link>(o.node, o.live.channels, options.roles, o.live.command_channel), o.live,
-      "live ROS 2 (DDS)");
+      std::make_unique<Ros2Link>(o.node, o.live.channels, options.roles, o.live.command_channel,
+                                 o.reset_odometry_service),
+      o.live, "live ROS 2 (DDS)");
 }
 
 namespace {
@@ -236,6 +317,7 @@ struct BridgeOptions {
   Ros2NodeOptions node;
   std::vector<std::string> publish = {topics::kLidar, topics::kOdometry, topics::kEncoders, topics::kImu};
   std::vector<std::string> subscribe = {topics::kVelocityCommand};
+  std::string reset_odometry_service = "/reset_odometry";  // served as the MBot's firmware does ("" = not)
 };
 
 class Ros2BridgeStage : public msgs::Stage {
@@ -248,10 +330,28 @@ class Ros2BridgeStage : public msgs::Stage {
     roles.reference_pose.clear();  // the pose coming back is the stack's estimate, not a reference
     roles.pose_estimate = {topics::kSlamPose};
     node_ = std::make_unique<Ros2Node>(o_.node, o_.subscribe, roles);
+    if (!o_.reset_odometry_service.empty()) {
+      // As the MBot's firmware: the odometry pose becomes (0, 0, 0) and counts on from there.
+      node_->ServeTrigger(o_.reset_odometry_service, [this] {
+        odometry_origin_ = last_odometry_;
+        mbot::log::Info("ros2_bridge: " + o_.reset_odometry_service + ": odometry reset");
+        return TriggerResponse{true, "Odometry reset to (0, 0, 0)"};
+      });
+    }
     mbot::log::Info("ros2_bridge: publishing " + std::to_string(publish_.size()) + " channels on " + node_->where());
   }
 
-  void OnEvent(const Event& ev) override {
+  void OnEvent(const Event& input) override {
+    const Event* in = &input;
+    if (input.kind == EventKind::kOdometry) {
+      if (const auto* p = std::get_if<msgs::Pose2D>(&input.payload)) {
+        last_odometry_ = *p;
+        reset_copy_ = input;
+        reset_copy_.payload = odometry_origin_.Inverse().Compose(*p);
+        in = &reset_copy_;
+      }
+    }
+    const Event& ev = *in;
     if (publish_.count(ev.channel) && node_->Publish(ev) && ev.kind == EventKind::kLidar)
       latency_.ScanSent(msgs::WallClockUs());
     got_.clear();
@@ -285,6 +385,8 @@ class Ros2BridgeStage : public msgs::Stage {
   std::unique_ptr<Ros2Node> node_;
   std::vector<Event> got_;
   msgs::LoopLatency latency_;
+  msgs::Pose2D last_odometry_, odometry_origin_;  // the robot's raw odometry, and where it was last reset
+  Event reset_copy_;
 };
 
 }  // namespace
@@ -302,6 +404,10 @@ msgs::StageType Ros2BridgeStageType() {
         ParseTreeFrames(s, "ros2_bridge", &o.node.frames);  // the robot's side publishes the mount
         o.publish = s.GetList("publish", o.publish, "channels published (what the robot's firmware and lidar publish)");
         o.subscribe = s.GetList("subscribe", o.subscribe, "channels listened to (the autonomy's commands and outputs)");
+        o.reset_odometry_service =
+            s.GetString("reset_odometry_service", o.reset_odometry_service,
+                        "ros2_bridge: the std_srvs/Trigger service that zeroes the published odometry, as the "
+                        "MBot's firmware serves it ('' = none)");
         return std::make_unique<Ros2BridgeStage>(o);
       }};
 }

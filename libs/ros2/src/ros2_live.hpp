@@ -5,7 +5,9 @@
 // msgs::LiveSource on it; the simulated robot's side is the `ros2_bridge` stage.
 #pragma once
 
+#include <functional>
 #include <map>
+#include <optional>
 #include <memory>
 #include <set>
 #include <string>
@@ -16,6 +18,7 @@
 #include "mbot/msgs/live_source.hpp"
 #include "mbot/msgs/stage.hpp"
 #include "mbot/ros2/dds.hpp"
+#include "mbot/ros2/messages.hpp"
 
 namespace mbot::config {
 class Section;
@@ -54,6 +57,17 @@ class Ros2Node {
   // A writer for `topic` now (so discovery is under way before the first message).
   void PrepareWriter(const std::string& wire, const std::string& type);
 
+  // A std_srvs/Trigger service (`service`, e.g. "/reset_odometry") this node answers: every request
+  // Poll takes is answered with `handler`'s response, in the request's form (with rmw_cyclonedds's
+  // header when it came with one, as a client on rmw_cyclonedds_cpp sends it).
+  void ServeTrigger(const std::string& service, std::function<TriggerResponse()> handler);
+  // Calls a std_srvs/Trigger service once, as the MBot's micro-ROS agent answers it (the request
+  // alone; the agent puts the request's identity in the RTPS message, which Cyclone's API does not
+  // show, so the first reply after the request is taken): waits up to timeout_ms for the service to
+  // be matched and to answer; the node's topics keep what arrives meanwhile for the next Poll.
+  // nullopt when no reply came in time.
+  std::optional<TriggerResponse> CallTrigger(const std::string& service, int timeout_ms);
+
   struct TopicStats {
     std::string type;
     long long received = 0, rejected = 0, published = 0;
@@ -80,6 +94,13 @@ class Ros2Node {
   std::map<std::string, std::string> writer_types_;
   std::map<std::string, TopicStats> stats_;
   std::vector<EncodedMessage> encoded_;
+  struct TriggerServer {
+    std::string service;
+    int reply_writer = -1;
+    std::function<TriggerResponse()> handler;
+  };
+  std::map<int, TriggerServer> servers_;  // by request reader index
+  std::set<int> service_readers_;         // reply readers of calls: not topics
 };
 
 std::unique_ptr<msgs::Source> OpenRos2Live(const msgs::SourceOptions& options);
@@ -92,6 +113,9 @@ msgs::OutputType Ros2OutputType();
 struct Ros2LiveOptions {
   Ros2NodeOptions node;
   msgs::LiveSourceOptions live;
+  // A std_srvs/Trigger service called once at start to zero the robot's odometry (the MBot's
+  // /reset_odometry); "" = none.
+  std::string reset_odometry_service;
 };
 
 }  // namespace mbot::ros2

@@ -101,6 +101,10 @@ void RegisterRos2Transport() {
         msgs::LiveSourceOptions d;
         d.channels = {msgs::topics::kLidar, msgs::topics::kOdometry, msgs::topics::kImu, msgs::topics::kEncoders};
         r.live = msgs::ParseLiveSourceOptions(s, "ros2_live", d);
+        r.reset_odometry_service = s.GetString(
+            "reset_odometry_service", "",
+            "ros2_live: a std_srvs/Trigger service called once at start to zero the robot's odometry (the MBot's "
+            "/reset_odometry; '' = none)");
         o->extra = r;
       },
       OpenRos2Live};

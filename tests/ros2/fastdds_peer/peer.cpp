@@ -7,7 +7,10 @@
 // a map in which the wall at −x is occupied and the gap at +x is not (the mount was applied), and
 // the autonomy announced itself on ros_discovery_info as rmw_cyclonedds does: a node "/mbot_nav"
 // whose writer GIDs hold the GUID of the writer its /cmd_vel came from, under that writer's
-// participant (what `ros2 node list` and `ros2 node info` read).
+// participant (what `ros2 node list` and `ros2 node info` read). It also serves /reset_odometry
+// (std_srvs/Trigger) as the MBot's micro-ROS agent does (Micro-XRCE-DDS-Agent's FastDDSReplier:
+// the reply carries the request's sample identity as its related sample identity) and requires a
+// request to have come and been answered.
 //   mbot_fastdds_peer <domain id> <seconds> [listen]
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
@@ -157,7 +160,11 @@ int main(int argc, char** argv) {
   TypeSupport twist_t(new geo::Twist_PubSubType());
   TypeSupport map_t(new nav_msgs::msg::dds_::OccupancyGrid_PubSubType());
   TypeSupport info_t(new rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_PubSubType());
-  for (TypeSupport* t : {&scan_t, &odom_t, &tf_t, &twist_t, &map_t, &info_t}) t->register_type(pp);
+  TypeSupport req_t(new std_srvs::srv::dds_::Trigger_Request_PubSubType());
+  TypeSupport rep_t(new std_srvs::srv::dds_::Trigger_Response_PubSubType());
+  for (TypeSupport* t : {&scan_t, &odom_t, &tf_t, &twist_t, &map_t, &info_t, &req_t, &rep_t}) t->register_type(pp);
+  Topic* req_topic = pp->create_topic("rq/reset_odometryRequest", req_t.get_type_name(), TOPIC_QOS_DEFAULT);
+  Topic* rep_topic = pp->create_topic("rr/reset_odometryReply", rep_t.get_type_name(), TOPIC_QOS_DEFAULT);
   Topic* info_topic = pp->create_topic("ros_discovery_info", info_t.get_type_name(), TOPIC_QOS_DEFAULT);
   Topic* scan_topic = pp->create_topic("rt/scan", scan_t.get_type_name(), TOPIC_QOS_DEFAULT);
   Topic* odom_topic = pp->create_topic("rt/odom", odom_t.get_type_name(), TOPIC_QOS_DEFAULT);
@@ -184,7 +191,15 @@ int main(int argc, char** argv) {
   info_q.durability().kind = TRANSIENT_LOCAL_DURABILITY_QOS;
   info_q.history().kind = KEEP_ALL_HISTORY_QOS;
   DataReader* info_r = sub->create_datareader(info_topic, info_q);
-  if (!scan_w || !odom_w || !tf_w || !cmd_r || !info_r) return std::fprintf(stderr, "peer: endpoints not created\n"), 2;
+  // The service's endpoints as rmw makes them: reliable, volatile, keep last 10.
+  DataReaderQos req_q = DATAREADER_QOS_DEFAULT;
+  req_q.reliability().kind = RELIABLE_RELIABILITY_QOS;
+  req_q.history().depth = 10;
+  DataReader* req_r = sub->create_datareader(req_topic, req_q);
+  DataWriter* rep_w = pub->create_datawriter(rep_topic, reliable);
+  if (!scan_w || !odom_w || !tf_w || !cmd_r || !info_r || !req_r || !rep_w)
+    return std::fprintf(stderr, "peer: endpoints not created\n"), 2;
+  long resets = 0, reset_replies = 0;
   std::set<std::string> cmd_writers;  // the 16-byte GUIDs /cmd_vel came from
 
   // The lidar's mount, as robot_state_publisher says it: z 0.142 m, yaw 180° (z axis up).
@@ -230,6 +245,18 @@ int main(int argc, char** argv) {
       ++scans;
       next_scan += std::chrono::milliseconds(100);
     }
+    std_srvs::srv::dds_::Trigger_Request_ request;
+    SampleInfo req_info;
+    while (req_r->take_next_sample(&request, &req_info) == ReturnCode_t::RETCODE_OK) {
+      if (!req_info.valid_data) continue;
+      ++resets;
+      std_srvs::srv::dds_::Trigger_Response_ reply;
+      reply.success(true);
+      reply.message("Odometry reset to (0, 0, 0)");
+      eprosima::fastrtps::rtps::WriteParams wp;
+      wp.related_sample_identity(req_info.sample_identity);
+      if (rep_w->write(&reply, wp)) ++reset_replies;
+    }
     geo::Twist_ t;
     SampleInfo info;
     while (cmd_r->take_next_sample(&t, &info) == ReturnCode_t::RETCODE_OK) {
@@ -246,6 +273,7 @@ int main(int argc, char** argv) {
   }
   std::printf("peer: published %ld scans, %ld odometry; received %ld /cmd_vel (%ld non-zero)\n", scans, odoms, commands,
               moving);
+  std::printf("peer: /reset_odometry: %ld requests, %ld replies\n", resets, reset_replies);
 
   // A reader that joins late: /map comes from the writer's history (transient local).
   DataReaderQos map_q = DATAREADER_QOS_DEFAULT;
@@ -311,9 +339,10 @@ int main(int argc, char** argv) {
   std::printf("peer: %d ros_discovery_info samples\n", announcements);
   pp->delete_contained_entities();
   DomainParticipantFactory::get_instance()->delete_participant(pp);
-  const bool ok = moving > 0 && got_map && wall_seen && gap_open && writer_listed && node_named;
+  const bool ok =
+      moving > 0 && got_map && wall_seen && gap_open && writer_listed && node_named && resets > 0 && reset_replies > 0;
   std::printf("%s\n", ok ? "PASS"
                          : "FAIL: no non-zero /cmd_vel, or no /map for the late reader, or a wrong map, or no node "
-                           "/mbot_nav on ros_discovery_info listing /cmd_vel's writer");
+                           "/mbot_nav on ros_discovery_info listing /cmd_vel's writer, or no /reset_odometry call");
   return ok ? 0 : 1;
 }

@@ -41,8 +41,10 @@ class DdsParticipant {
 
   // A reader or writer on ROS topic `topic` of ROS type `type`; returns its index. Throws
   // std::runtime_error naming the topic when Cyclone refuses it (a name DDS cannot take).
-  int AddReader(const std::string& topic, const std::string& type, const Qos& qos);
-  int AddWriter(const std::string& topic, const std::string& type, const Qos& qos);
+  // `dds_name`: `topic` is the DDS topic as it is (a service's rq/…Request, rr/…Reply), not a ROS
+  // topic put under rt/.
+  int AddReader(const std::string& topic, const std::string& type, const Qos& qos, bool dds_name = false);
+  int AddWriter(const std::string& topic, const std::string& type, const Qos& qos, bool dds_name = false);
 
   // Writes one CDR payload (with its 4-byte encapsulation header); false when it could not be.
   bool Write(int writer, const uint8_t* cdr, size_t size);
@@ -56,6 +58,8 @@ class DdsParticipant {
   };
   // Waits up to timeout_ms for data on any reader, then takes every sample waiting on all of them.
   void Take(int timeout_ms, const std::function<void(const Sample&)>& on_sample);
+  // Sleeps timeout_ms, then takes what waits on `reader` alone (the others keep theirs).
+  void TakeFrom(int reader, int timeout_ms, const std::function<void(const Sample&)>& on_sample);
 
   // Remote endpoints matched so far (discovery), for tests and start-up waits.
   int MatchedReaders(int writer) const;

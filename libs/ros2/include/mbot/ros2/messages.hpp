@@ -163,6 +163,30 @@ inline constexpr const char* kEncodersType = "mbot_interfaces/msg/Encoders";
 inline constexpr const char* kMotorVelocityType = "mbot_interfaces/msg/MotorVelocity";
 inline constexpr const char* kMarkerArrayType = "visualization_msgs/msg/MarkerArray";
 inline constexpr const char* kAprilTagDetectionArrayType = "apriltag_msgs/msg/AprilTagDetectionArray";
+// std_srvs/srv/Trigger (the MBot's /reset_odometry): its request and response as they travel on DDS,
+// on rq/<service>Request and rr/<service>Reply.
+inline constexpr const char* kTriggerRequestType = "std_srvs/srv/Trigger_Request";
+inline constexpr const char* kTriggerResponseType = "std_srvs/srv/Trigger_Response";
+
+struct TriggerResponse {  // std_srvs/Trigger's response
+  bool success = false;
+  std::string message;
+};
+// rmw_cyclonedds_cpp puts this request header (the client's writer handle, a sequence number) in
+// front of every request and response; rmw_fastrtps and micro-ROS carry the request's identity in
+// the RTPS message instead, and their payloads are the message alone.
+struct ServiceHeader {
+  uint64_t guid = 0;
+  int64_t sequence = 0;
+};
+// Trigger's request (empty: one uint8 placeholder), with rmw_cyclonedds's header when given.
+std::vector<uint8_t> EncodeTriggerRequest(const ServiceHeader* header = nullptr);
+// Checks a request; true when it carried rmw_cyclonedds's header (then `header` holds it). Throws
+// CdrError for a payload that is neither form.
+bool DecodeTriggerRequest(const uint8_t* data, size_t size, ServiceHeader* header);
+std::vector<uint8_t> Encode(const TriggerResponse& m, const ServiceHeader* header = nullptr);
+// A response without the header (what the MBot's micro-ROS agent sends).
+TriggerResponse DecodeTriggerResponse(const uint8_t* data, size_t size);
 
 // How a payload is serialized: ROS 2's CDR, or ROS 1's (a ROS 1 bag: packed, Header with seq).
 enum class Serialization { kCdr, kRos1 };
