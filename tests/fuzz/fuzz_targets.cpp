@@ -22,6 +22,7 @@
 #include "mbot/drivers/map_io.hpp"
 #include "mbot/drivers/source_options.hpp"
 #include "mbot/lcm/lcm_sources.hpp"
+#include "scratch.hpp"
 
 namespace mbot::mapping {
 void RegisterScanRenderer();  // libs/mapping: scan_renderer.cpp
@@ -31,22 +32,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A folder of this process's own for the files the readers open.
-const fs::path& Scratch() {
-  static const fs::path dir = [] {
-    mbot::log::SetLevel(mbot::log::Level::kQuiet);
-    const fs::path d = fs::temp_directory_path() / ("mbot_fuzz_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
-
+using mbot::fuzz::Scratch;
 std::string Write(const std::string& name, const uint8_t* data, size_t size) {
-  const std::string path = (Scratch() / name).string();
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
-  return path;
+  return mbot::fuzz::WriteFile(Scratch() / name, data, size);
 }
 
 // Opens `path` as a source of `type` and reads every event.

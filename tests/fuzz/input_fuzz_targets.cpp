@@ -3,7 +3,6 @@
 // function (tests/fuzz/CMakeLists.txt); a rejection with a std::exception is the reader's job, a
 // crash, sanitizer report, hang or allocation beyond libFuzzer's limits is a finding.
 // Run one: scripts/fuzz.sh TARGET SECONDS.
-#include <unistd.h>
 
 #include <cstdint>
 #include <exception>
@@ -22,39 +21,27 @@
 #include "mbot/vision/apriltag_detector.hpp"
 #include "mbot/vision/camera_calibration.hpp"
 #include "mbot/vision/tag_observer.hpp"
+#include "scratch.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path& Scratch() {
-  static const fs::path dir = [] {
-    mbot::log::SetLevel(mbot::log::Level::kQuiet);
-    const fs::path d = fs::temp_directory_path() / ("mbot_fuzz_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
-
-std::string Write(const fs::path& path, const uint8_t* data, size_t size) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
-  return path.string();
-}
+using mbot::fuzz::Scratch;
+using mbot::fuzz::WriteFile;
 
 [[maybe_unused]] void Arena(const uint8_t* d, size_t n) {
   mbot::sim::World::ParseArena(std::string(reinterpret_cast<const char*>(d), n), "fuzz.arena");
 }
 
 [[maybe_unused]] void CameraYaml(const uint8_t* d, size_t n) {
-  const std::string path = Write(Scratch() / "camera.yaml", d, n);
+  const std::string path = WriteFile(Scratch() / "camera.yaml", d, n);
   mbot::vision::ReadCameraYaml(path);
   mbot::vision::IntrinsicsFromYaml(path);
 }
 
 [[maybe_unused]] void Relations(const uint8_t* d, size_t n) {
-  mbot::motion::ReadRelations(Write(Scratch() / "in.relations", d, n));
+  mbot::motion::ReadRelations(WriteFile(Scratch() / "in.relations", d, n));
 }
 
 // The first byte picks the file's name (PNG, JPEG, BMP, PGM, TIFF); the rest is the file, the only
@@ -66,7 +53,7 @@ std::string Write(const fs::path& path, const uint8_t* data, size_t size) {
   const fs::path dir = Scratch() / "images";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  Write(dir / kNames[d[0] % 5], d + 1, n - 1);
+  WriteFile(dir / kNames[d[0] % 5], d + 1, n - 1);
   mbot::msgs::SourceOptions o;
   o.path = dir.string();
   o.type = "camera";

@@ -498,14 +498,24 @@ std::vector<motion::Pose2D> World::PosesLabelled(const std::string& label) const
   return out;
 }
 
+namespace {
+
+// The true map's cell of `start`; throws, naming `who`, when it is not a free one.
+void StartCell(const World& world, const motion::Pose2D& start, const char* who, int* sx, int* sy) {
+  const auto& g = world.truth();
+  g.WorldToCell(start.x, start.y, sx, sy);
+  if (!g.IsInside(*sx, *sy) || g.at(*sx, *sy) >= 0) {
+    throw std::runtime_error(std::string(who) + ": start (" + Num(start.x) + ", " + Num(start.y) +
+                             ") is not in a free cell of the true map of '" + world.name() + "'");
+  }
+}
+
+}  // namespace
+
 std::vector<uint8_t> ReachableFreeMask(const World& world, const motion::Pose2D& start) {
   const auto& g = world.truth();
   int sx, sy;
-  g.WorldToCell(start.x, start.y, &sx, &sy);
-  if (!g.IsInside(sx, sy) || g.at(sx, sy) >= 0) {
-    throw std::runtime_error("ReachableFreeMask: start (" + Num(start.x) + ", " + Num(start.y) +
-                             ") is not in a free cell of the true map of '" + world.name() + "'");
-  }
+  StartCell(world, start, "ReachableFreeMask", &sx, &sy);
   std::vector<uint8_t> mask(g.cells().size(), 0);
   std::vector<int> stack{sy * g.width() + sx};
   mask[stack.back()] = 1;
@@ -530,11 +540,7 @@ std::vector<uint8_t> ReachableFreeMask(const World& world, const motion::Pose2D&
 std::vector<uint8_t> BodyReachableMask(const World& world, const motion::Pose2D& start, double radius_m) {
   const auto& g = world.truth();
   int sx, sy;
-  g.WorldToCell(start.x, start.y, &sx, &sy);
-  if (!g.IsInside(sx, sy) || g.at(sx, sy) >= 0) {
-    throw std::runtime_error("BodyReachableMask: start (" + Num(start.x) + ", " + Num(start.y) +
-                             ") is not in a free cell of the true map of '" + world.name() + "'");
-  }
+  StartCell(world, start, "BodyReachableMask", &sx, &sy);
   const int w = g.width(), h = g.height();
   // Where the centre may be: free cells with room for the body (the start's cell always).
   std::vector<uint8_t> roomy(g.cells().size(), 0);
