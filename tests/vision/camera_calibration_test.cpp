@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <sstream>
 
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -144,6 +145,15 @@ TEST(CameraCalibrationTest, CamerasThatCannotBeRightAreRefusedNamingTheKey) {
   EXPECT_EQ(error("530.", "0.1, 0., 0.", 3),
             path + ": distortion_coefficients: has 3 values; OpenCV takes 4, 5, 8, 12 or 14");
   EXPECT_EQ(error("530.", zeros, 5, "0"), path + ": image_width: 0 px is not in 1-16384");
+  // A quoted text value, as OpenCV's calibration sample writes the time, is a camera file's line.
+  {
+    ASSERT_EQ(error("530.", zeros), "(no error)");  // writes the good camera file
+    std::ifstream in(path);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::ofstream(path) << text.str() << "calibration_time: \"Thu Dec  4 10:00:00 2026\"\n";
+    EXPECT_NO_THROW(ReadCameraYaml(path));
+  }
   // Text on which OpenCV 4.6's own YAML parser never returns (found by the camera_yaml fuzz target).
   std::ofstream(path) << "%YAML:1.\n a:[]\na---\n";
   try {

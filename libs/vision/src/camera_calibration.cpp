@@ -215,6 +215,12 @@ void CheckCameraText(const std::string& path) {
                      t.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") == colon;
     std::string rest = key ? t.substr(colon + 1) : t;
     if (key && rest.find("!!opencv-matrix") != std::string::npos) continue;
+    // A quoted text value (OpenCV's calibration sample writes calibration_time: "Thu Dec  4 …").
+    const size_t q0 = rest.find('"');
+    if (key && q0 != std::string::npos && rest.find('"', q0 + 1) == rest.find_last_of('"') &&
+        rest.find_last_of('"') > q0 && rest.find_first_not_of(" \t") == q0 &&
+        rest.find_first_not_of(" \t", rest.find_last_of('"') + 1) == std::string::npos)
+      continue;
     // A value or a data line: numbers, with the brackets and commas of a sequence, or a word value
     // (dt: d, a calibration's date).
     bool ok = true;
