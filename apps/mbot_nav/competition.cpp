@@ -19,8 +19,9 @@ namespace {
 
 // Another world for an event: the organisers hand the team that world's inputs (libs/sim) through
 // the event's own keys, read here with the event's settings.
-void HandOutInputs(const std::string& world_path, const std::string& dir, config::Config* event) {
+void HandOutInputs(const std::string& world_path, const std::string& dir, bool waypoints_given, config::Config* event) {
   sim::EventSetup setup;
+  setup.waypoints_given = waypoints_given;
   config::Section mission = event->GetSection("mission"), slam = event->GetSection("slam");
   setup.task = mission.Has("task") ? mission.GetString("task", "", "") : "";
   setup.localization = slam.Has("mode") && slam.GetString("mode", "", "") == "localization";
@@ -71,6 +72,8 @@ CompetitionPlan BuildCompetition(const config::Config& config) {
     const long long event_seed = e.GetInt("seed", seed, "this event's seed", 0);
     const std::string set_text =
         e.GetString("set", "", "section.key=value overrides of the event's configuration, separated by ';'");
+    const std::string waypoints = e.GetString(
+        "waypoints", "", "the circuit on a world that names none (a map): x, y, theta_deg; … in the start's frame");
     e.Finish();
     const std::vector<std::string> sets = SplitTrimmed(set_text, ';');
     if (!world.empty() && !std::filesystem::exists(world)) e.Fail("world", world + ": no such file");
@@ -85,6 +88,7 @@ CompetitionPlan BuildCompetition(const config::Config& config) {
       event.Set("pipeline.progress=off");  // the events are short; the table is the report
       event.Set("output.dir=" + plan.output_dir + "/" + name);
       if (!world.empty()) event.Set("source.path=" + world);
+      if (!waypoints.empty()) event.Set("mission.waypoints=" + waypoints);
       for (const std::string& s : sets) event.Set(s);
     } catch (const config::ConfigError& err) {
       e.Fail("set", err.what());
@@ -93,7 +97,7 @@ CompetitionPlan BuildCompetition(const config::Config& config) {
       // The world's inputs, handed out with the event's own settings (its task, SLAM's resolution);
       // an explicit `set` of the same keys still wins.
       try {
-        HandOutInputs(world, plan.output_dir + "/" + name, &event);
+        HandOutInputs(world, plan.output_dir + "/" + name, !waypoints.empty(), &event);
         for (const std::string& s : sets) event.Set(s);
       } catch (const std::exception& err) {
         e.Fail("world", err.what());

@@ -22,11 +22,12 @@ std::vector<std::string> HandOut(const World& world, const std::string& world_pa
   const EventInputs in = EventInputsOf(world);
   std::vector<std::string> sets;
   if (setup.task == "waypoints") {
-    if (in.waypoints.empty()) {
+    if (in.waypoints.empty() && !setup.waypoints_given) {
       throw std::invalid_argument(world_path +
-                                  " has no 'pose start' and 'pose waypoint' lines: no circuit to hand out");
+                                  " has no 'pose start' and 'pose waypoint' lines: no circuit to hand out (give one "
+                                  "with the event's waypoints = x, y, theta_deg; …, in the start's frame)");
     }
-    sets.push_back("mission.waypoints=" + Poses(in.waypoints));
+    if (!in.waypoints.empty()) sets.push_back("mission.waypoints=" + Poses(in.waypoints));
   }
   if (setup.task == "warehouse") {
     if (in.targets.empty() || in.dropoffs.empty()) {

@@ -16,6 +16,9 @@ struct EventSetup {
   std::string task;  // "waypoints", "warehouse", …; another task needs nothing handed out
   bool localization = false;
   double resolution_m = 0.05;
+  // The event gives its own circuit (the competition's `waypoints` key): a world without `waypoint`
+  // poses (a map) needs none handed out.
+  bool waypoints_given = false;
 };
 
 // The settings for `setup` in `world`: mission.waypoints (the `waypoint` poses in the `start`
