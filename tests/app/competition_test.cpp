@@ -116,11 +116,9 @@ TEST(MazeExplorer, InterruptedRunStillWritesMapTrajectoriesAndScore) {
   plan.stages.emplace_back("stop_after", std::make_unique<StopAfter>(&stop, 8000));
   const pipeline::RunSummary summary = pipeline::RunPlan(plan, stop);
   EXPECT_TRUE(summary.interrupted);
-  std::ifstream in(out + "/score.json");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  EXPECT_NE(ss.str().find("\"interrupted\": true"), std::string::npos) << ss.str();
-  EXPECT_NE(ss.str().find("\"completed\": false"), std::string::npos);
+  const std::string score = ReadReport(out + "/score.json");
+  EXPECT_NE(score.find("\"interrupted\": true"), std::string::npos) << score;
+  EXPECT_NE(score.find("\"completed\": false"), std::string::npos);
   for (const char* f : {"final_map.png", "final_map.map", "true_path.tum", "slam_path.tum", "mission.json"}) {
     EXPECT_GT(std::filesystem::file_size(out + "/" + f), 0u) << f;
   }
@@ -145,10 +143,7 @@ TEST(Recording, ASimulatedRunReplaysThroughTheLogSource) {
   auto plan = pipeline::BuildPlan(c);
   std::atomic<bool> stop{false};
   pipeline::RunPlan(plan, stop);
-  std::ifstream in(out + "/metrics.json");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string replay = ss.str();
+  const std::string replay = ReadReport(out + "/metrics.json");
   ASSERT_FALSE(replay.empty());
   EXPECT_EQ(Get(replay, {"scans"}), Get(live, {"scans"}));
   EXPECT_EQ(Get(replay, {"scans_skipped"}), 0);
@@ -168,10 +163,7 @@ TEST(Competition, RunsEveryEventAndWritesOneTable) {
   ASSERT_EQ(plan.events.size(), 4u);
   std::atomic<bool> stop{false};
   EXPECT_EQ(RunCompetition(plan, stop), 0);
-  std::ifstream in(out + "/competition.json");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string j = ss.str();
+  const std::string j = ReadReport(out + "/competition.json");
   for (const char* e : {"Speed Run", "Maze Explorer", "Warehouse", "Heavy Lift"})
     EXPECT_NE(j.find(e), std::string::npos) << j;
   EXPECT_NE(j.find("\"not_run\": []"), std::string::npos) << j;

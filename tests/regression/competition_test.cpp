@@ -9,8 +9,6 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <tuple>
 
@@ -62,14 +60,12 @@ TEST(BotlabArena, SpeedRunDrivesAGivenCircuitOnCenterMaze) {
   CompetitionPlan plan = BuildCompetition(c);
   std::atomic<bool> stop{false};
   RunCompetition(plan, stop);
-  std::ifstream in(out + "/speed_run/score.json");
-  std::stringstream j;
-  j << in.rdbuf();
-  ASSERT_FALSE(j.str().empty());
-  EXPECT_NE(j.str().find("\"completed\": true"), std::string::npos) << j.str();
-  EXPECT_EQ(Get(j.str(), {"collisions"}), 0);
-  EXPECT_LT(std::hypot(Get(j.str(), {"final_error", "x_m"}), Get(j.str(), {"final_error", "y_m"})), 0.05);
-  ::testing::Test::RecordProperty("time_s", std::to_string(Get(j.str(), {"time_s"})));
+  const std::string j = ReadReport(out + "/speed_run/score.json");
+  ASSERT_FALSE(j.empty());
+  EXPECT_NE(j.find("\"completed\": true"), std::string::npos) << j;
+  EXPECT_EQ(Get(j, {"collisions"}), 0);
+  EXPECT_LT(std::hypot(Get(j, {"final_error", "x_m"}), Get(j, {"final_error", "y_m"})), 0.05);
+  ::testing::Test::RecordProperty("time_s", std::to_string(Get(j, {"time_s"})));
 }
 
 }  // namespace

@@ -17,6 +17,14 @@
 
 namespace mbot::app {
 
+// The text of a report a run wrote ("" when it was not written).
+inline std::string ReadReport(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
 // Runs config/<config_name> with `sets` (section.key=value, or "--unset section.key") into TempDir()/<out_name>;
 // returns the text of <report> in that folder ("" when it was not written).
 inline std::string RunConfig(const std::string& config_name, const std::string& out_name,
@@ -30,10 +38,7 @@ inline std::string RunConfig(const std::string& config_name, const std::string& 
   auto plan = pipeline::BuildPlan(c);
   std::atomic<bool> stop{false};
   pipeline::RunPlan(plan, stop);
-  std::ifstream in(out + "/" + report);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+  return ReadReport(out + "/" + report);
 }
 
 // The number after the keys, found one after another in the JSON text (e.g. "slam_ate",

@@ -52,20 +52,16 @@ bool PnmField(const std::string& b, size_t* at, int64_t* value) {
 
 }  // namespace
 
-ImageHeader CheckImageBytes(const std::string& b, const std::string& name) {
-  ImageHeader h;
+void CheckImageBytes(const std::string& b, const std::string& name) {
   auto starts = [&](const char* magic, size_t n) { return b.size() >= n && b.compare(0, n, magic, n) == 0; };
   if (starts("\x89PNG\r\n\x1a\n", 8)) {
-    h.format = "png";
     if (b.size() < 24 || b.compare(12, 4, "IHDR") != 0) Fail(name, "PNG without its IHDR header");
     CheckSize(name, "PNG", Be32(b, 16), Be32(b, 20));
-    h.width = static_cast<int>(Be32(b, 16)), h.height = static_cast<int>(Be32(b, 20));
     // The last chunk is IEND: length 0, type, CRC.
     static const char kIend[] = "\0\0\0\0IEND\xae\x42\x60\x82";
     if (b.size() < 12 || b.compare(b.size() - 12, 12, kIend, 12) != 0)
       Fail(name, "truncated PNG (it does not end with its IEND chunk)");
   } else if (starts("\xff\xd8", 2)) {
-    h.format = "jpeg";
     size_t at = 2;
     while (true) {
       while (at < b.size() && static_cast<uint8_t>(b[at]) != 0xff) ++at;  // to the next marker
@@ -80,7 +76,6 @@ ImageHeader CheckImageBytes(const std::string& b, const std::string& name) {
       if (m >= 0xc0 && m <= 0xcf && m != 0xc4 && m != 0xc8 && m != 0xcc) {
         if (at + 8 > b.size()) Fail(name, "JPEG frame header cut short");
         CheckSize(name, "JPEG", Be16(b, at + 6), Be16(b, at + 4));
-        h.width = static_cast<int>(Be16(b, at + 6)), h.height = static_cast<int>(Be16(b, at + 4));
         break;
       }
       if (len < 2) Fail(name, "JPEG segment of length " + std::to_string(len) + " at byte " + std::to_string(at));
@@ -92,32 +87,26 @@ ImageHeader CheckImageBytes(const std::string& b, const std::string& name) {
     if (end < 2 || static_cast<uint8_t>(b[end - 2]) != 0xff || static_cast<uint8_t>(b[end - 1]) != 0xd9)
       Fail(name, "truncated JPEG (it does not end with the end-of-image marker FF D9)");
   } else if (starts("BM", 2)) {
-    h.format = "bmp";
     if (b.size() < 26) Fail(name, "BMP header cut short");
     const int64_t w = Le32(b, 18), hh = Le32(b, 22);
     CheckSize(name, "BMP", w, hh < 0 ? -hh : hh);
-    h.width = static_cast<int>(w), h.height = static_cast<int>(hh < 0 ? -hh : hh);
   } else if (b.size() >= 2 && b[0] == 'P' && b[1] >= '1' && b[1] <= '6') {
-    h.format = "pnm";
     size_t at = 2;
     int64_t w = 0, hh = 0;
     if (!PnmField(b, &at, &w) || !PnmField(b, &at, &hh)) Fail(name, "PNM header without a width and height");
     CheckSize(name, "PNM", w, hh);
-    h.width = static_cast<int>(w), h.height = static_cast<int>(hh);
-  } else if (starts("II*\0", 4) || starts("MM\0*", 4)) {
-    h.format = "tiff";  // its size sits in an IFD anywhere in the file: OpenCV's own limits apply
-  } else {
+  } else if (!starts("II*\0", 4) && !starts("MM\0*", 4)) {
+    // (A TIFF passes: its size sits in an IFD anywhere in the file, so OpenCV's own limits apply.)
     Fail(name, "not an image of a kind read here (no PNG, JPEG, BMP, PNM or TIFF signature)");
   }
-  return h;
 }
 
-ImageHeader CheckImageFile(const std::string& path) {
+void CheckImageFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) Fail(path, "cannot open");
   std::ostringstream s;
   s << in.rdbuf();
-  return CheckImageBytes(s.str(), path);
+  CheckImageBytes(s.str(), path);
 }
 
 }  // namespace mbot::drivers

@@ -334,6 +334,7 @@ class Ros2BridgeStage : public msgs::Stage {
       // As the MBot's firmware: the odometry pose becomes (0, 0, 0) and counts on from there.
       node_->ServeTrigger(o_.reset_odometry_service, [this] {
         odometry_origin_ = last_odometry_;
+        odometry_reset_ = true;
         mbot::log::Info("ros2_bridge: " + o_.reset_odometry_service + ": odometry reset");
         return TriggerResponse{true, "Odometry reset to (0, 0, 0)"};
       });
@@ -346,9 +347,11 @@ class Ros2BridgeStage : public msgs::Stage {
     if (input.kind == EventKind::kOdometry) {
       if (const auto* p = std::get_if<msgs::Pose2D>(&input.payload)) {
         last_odometry_ = *p;
-        reset_copy_ = input;
-        reset_copy_.payload = odometry_origin_.Inverse().Compose(*p);
-        in = &reset_copy_;
+        if (odometry_reset_) {  // the published odometry counts from where it was reset
+          reset_copy_ = input;
+          reset_copy_.payload = odometry_origin_.Inverse().Compose(*p);
+          in = &reset_copy_;
+        }
       }
     }
     const Event& ev = *in;
@@ -386,6 +389,7 @@ class Ros2BridgeStage : public msgs::Stage {
   std::vector<Event> got_;
   msgs::LoopLatency latency_;
   msgs::Pose2D last_odometry_, odometry_origin_;  // the robot's raw odometry, and where it was last reset
+  bool odometry_reset_ = false;
   Event reset_copy_;
 };
 

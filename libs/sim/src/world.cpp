@@ -500,25 +500,30 @@ std::vector<motion::Pose2D> World::PosesLabelled(const std::string& label) const
 
 namespace {
 
-// The true map's cell of `start`; throws, naming `who`, when it is not a free one.
-void StartCell(const World& world, const motion::Pose2D& start, const char* who, int* sx, int* sy) {
+// The true map's cell of `start`, as an index; throws, naming `who`, when it is not a free one.
+int StartCell(const World& world, const motion::Pose2D& start, const char* who) {
   const auto& g = world.truth();
-  g.WorldToCell(start.x, start.y, sx, sy);
-  if (!g.IsInside(*sx, *sy) || g.at(*sx, *sy) >= 0) {
+  int sx, sy;
+  g.WorldToCell(start.x, start.y, &sx, &sy);
+  if (!g.IsInside(sx, sy) || g.at(sx, sy) >= 0) {
     throw std::runtime_error(std::string(who) + ": start (" + Num(start.x) + ", " + Num(start.y) +
                              ") is not in a free cell of the true map of '" + world.name() + "'");
   }
+  return sy * g.width() + sx;
 }
 
-}  // namespace
+// The true map's free cells.
+std::vector<uint8_t> FreeCells(const mapping::OccupancyGrid& g) {
+  std::vector<uint8_t> free(g.cells().size());
+  for (size_t i = 0; i < free.size(); ++i) free[i] = g.cells()[i] < 0;
+  return free;
+}
 
-std::vector<uint8_t> ReachableFreeMask(const World& world, const motion::Pose2D& start) {
-  const auto& g = world.truth();
-  int sx, sy;
-  StartCell(world, start, "ReachableFreeMask", &sx, &sy);
+// The cells 4-connected to `start` through cells `passable` (indexed as the true map's), `start` included.
+std::vector<uint8_t> Flood(const mapping::OccupancyGrid& g, int start, const std::vector<uint8_t>& passable) {
   std::vector<uint8_t> mask(g.cells().size(), 0);
-  std::vector<int> stack{sy * g.width() + sx};
-  mask[stack.back()] = 1;
+  std::vector<int> stack{start};
+  mask[start] = 1;
   while (!stack.empty()) {
     const int c = stack.back();
     stack.pop_back();
@@ -528,7 +533,7 @@ std::vector<uint8_t> ReachableFreeMask(const World& world, const motion::Pose2D&
     for (int k = 0; k < 4; ++k) {
       if (!g.IsInside(nx[k], ny[k])) continue;
       const int n = ny[k] * g.width() + nx[k];
-      if (!mask[n] && g.cells()[n] < 0) {
+      if (!mask[n] && passable[n]) {
         mask[n] = 1;
         stack.push_back(n);
       }
@@ -537,10 +542,15 @@ std::vector<uint8_t> ReachableFreeMask(const World& world, const motion::Pose2D&
   return mask;
 }
 
+}  // namespace
+
+std::vector<uint8_t> ReachableFreeMask(const World& world, const motion::Pose2D& start) {
+  return Flood(world.truth(), StartCell(world, start, "ReachableFreeMask"), FreeCells(world.truth()));
+}
+
 std::vector<uint8_t> BodyReachableMask(const World& world, const motion::Pose2D& start, double radius_m) {
   const auto& g = world.truth();
-  int sx, sy;
-  StartCell(world, start, "BodyReachableMask", &sx, &sy);
+  const int start_cell = StartCell(world, start, "BodyReachableMask");
   const int w = g.width(), h = g.height();
   // Where the centre may be: free cells with room for the body (the start's cell always).
   std::vector<uint8_t> roomy(g.cells().size(), 0);
@@ -552,25 +562,8 @@ std::vector<uint8_t> BodyReachableMask(const World& world, const motion::Pose2D&
       roomy[static_cast<size_t>(j) * w + i] = world.ClearanceAt(x, y) >= radius_m;
     }
   }
-  roomy[static_cast<size_t>(sy) * w + sx] = 1;
-  std::vector<uint8_t> centre(g.cells().size(), 0);
-  std::vector<int> stack{sy * w + sx};
-  centre[stack.back()] = 1;
-  while (!stack.empty()) {
-    const int c = stack.back();
-    stack.pop_back();
-    const int cx = c % w, cy = c / w;
-    const int nx[4] = {cx + 1, cx - 1, cx, cx};
-    const int ny[4] = {cy, cy, cy + 1, cy - 1};
-    for (int k = 0; k < 4; ++k) {
-      if (nx[k] < 0 || ny[k] < 0 || nx[k] >= w || ny[k] >= h) continue;
-      const int n = ny[k] * w + nx[k];
-      if (!centre[n] && roomy[n]) {
-        centre[n] = 1;
-        stack.push_back(n);
-      }
-    }
-  }
+  roomy[start_cell] = 1;
+  const std::vector<uint8_t> centre = Flood(g, start_cell, roomy);
   // The body: free cells within the radius of a centre cell (the centre's clearance keeps the disc
   // free of walls, so nothing behind a wall is reached).
   cv::Mat not_centre(h, w, CV_8U);
@@ -596,9 +589,7 @@ namespace {
 std::vector<uint8_t> ReachableFromStart(const World& world) {
   const std::vector<motion::Pose2D> starts = world.PosesLabelled("start");
   if (!starts.empty()) return ReachableFreeMask(world, starts.front());
-  std::vector<uint8_t> mask(world.truth().cells().size());
-  for (size_t i = 0; i < mask.size(); ++i) mask[i] = world.truth().cells()[i] < 0;
-  return mask;
+  return FreeCells(world.truth());
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/files.hpp"
+#include "mbot/common/strings.hpp"
 
 namespace mbot::vision {
 namespace {
@@ -135,6 +136,73 @@ void WriteCameraYaml(const CalibrationResult& r, const ChessboardOptions& o, con
   CommitFile(tmp, path);
 }
 
+namespace {
+
+// OpenCV 4.6's YAML parser loops forever on some malformed text ("%YAML:1.0\n a:[]\na---\n", found by
+// the camera_yaml fuzz target), so a camera file is checked line by line first: the lines OpenCV's
+// writer makes (a %YAML header, ---, comments, `key: value`, `key: !!opencv-matrix`) and data lines
+// of numbers only. Anything else is refused naming the line.
+void CheckCameraText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  int line_no = 0;
+  size_t total = 0;
+  auto number = [](const std::string& t) {
+    static const char* const kSpecial[] = {".nan", ".NaN", ".NAN", ".inf", ".Inf", ".INF", "-.inf", "-.Inf", "-.INF"};
+    for (const char* s : kSpecial) {
+      if (t == s) return true;
+    }
+    char* end = nullptr;
+    std::strtod(t.c_str(), &end);
+    return !t.empty() && end == t.c_str() + t.size();
+  };
+  while (std::getline(in, line)) {
+    ++line_no;
+    total += line.size() + 1;
+    if (total > (1u << 20)) throw std::runtime_error(path + ": larger than 1 MiB: not a camera file");
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const size_t first = line.find_first_not_of(" \t");
+    if (first == std::string::npos || line[first] == '#') continue;
+    const std::string t = line.substr(first);
+    if ((line_no == 1 && t.rfind("%YAML", 0) == 0) || t == "---") continue;
+    const size_t colon = t.find(':');
+    const bool key = colon != std::string::npos && colon > 0 &&
+                     t.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") == colon;
+    std::string rest = key ? t.substr(colon + 1) : t;
+    if (key && rest.find("!!opencv-matrix") != std::string::npos) continue;
+    // A quoted text value (OpenCV's calibration sample writes calibration_time: "Thu Dec  4 …").
+    const std::string value = Trim(rest);
+    if (key && value.size() >= 2 && value.front() == '"' && value.find('"', 1) == value.size() - 1) continue;
+    // A value or a data line: numbers, with the brackets and commas of a sequence, or a word value
+    // (dt: d, a calibration's date).
+    bool ok = true;
+    std::string token;
+    int words = 0;
+    for (size_t i = 0; i <= rest.size(); ++i) {
+      const char c = i < rest.size() ? rest[i] : ' ';
+      if (c == ' ' || c == '\t' || c == ',' || c == '[' || c == ']') {
+        if (!token.empty() && !number(token)) {
+          ok = key && token.find_first_of("-:[]{}") == std::string::npos;
+          ++words;
+        }
+        if (!ok) break;
+        token.clear();
+      } else {
+        token += c;
+      }
+    }
+    if (!ok || (!key && words > 0) || (key && rest.find_first_of("{}\"'") != std::string::npos)) {
+      throw std::runtime_error(path + ": line " + std::to_string(line_no) + ": '" + t.substr(0, 80) +
+                               "' is not a line of an OpenCV camera file");
+    }
+  }
+}
+
+// The largest image side a camera file may give [px].
+constexpr int kMaxCameraSidePx = 16384;
+
+// Refuses a camera that cannot be right, naming `path` and the key (ReadCameraYaml says which);
+// the distortion comes back as one row of doubles.
 void ValidateCamera(CalibrationResult& r, const std::string& path) {
   auto fail = [&](const std::string& key, const std::string& why) {
     throw std::runtime_error(path + ": " + key + ": " + why);
@@ -177,71 +245,6 @@ void ValidateCamera(CalibrationResult& r, const std::string& path) {
   for (int i = 0; i < n; ++i) {
     if (!std::isfinite(d.at<double>(0, i)) || std::abs(d.at<double>(0, i)) > 1e6) {
       fail("distortion_coefficients", "value " + std::to_string(i) + " is " + text(d.at<double>(0, i)));
-    }
-  }
-}
-
-namespace {
-
-// OpenCV 4.6's YAML parser loops forever on some malformed text ("%YAML:1.0\n a:[]\na---\n", found by
-// the camera_yaml fuzz target), so a camera file is checked line by line first: the lines OpenCV's
-// writer makes (a %YAML header, ---, comments, `key: value`, `key: !!opencv-matrix`) and data lines
-// of numbers only. Anything else is refused naming the line.
-void CheckCameraText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string line;
-  int line_no = 0;
-  size_t total = 0;
-  auto number = [](const std::string& t) {
-    static const char* const kSpecial[] = {".nan", ".NaN", ".NAN", ".inf", ".Inf", ".INF", "-.inf", "-.Inf", "-.INF"};
-    for (const char* s : kSpecial) {
-      if (t == s) return true;
-    }
-    char* end = nullptr;
-    std::strtod(t.c_str(), &end);
-    return !t.empty() && end == t.c_str() + t.size();
-  };
-  while (std::getline(in, line)) {
-    ++line_no;
-    total += line.size() + 1;
-    if (total > (1u << 20)) throw std::runtime_error(path + ": larger than 1 MiB: not a camera file");
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    const size_t first = line.find_first_not_of(" \t");
-    if (first == std::string::npos || line[first] == '#') continue;
-    const std::string t = line.substr(first);
-    if ((line_no == 1 && t.rfind("%YAML", 0) == 0) || t == "---") continue;
-    const size_t colon = t.find(':');
-    const bool key = colon != std::string::npos && colon > 0 &&
-                     t.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") == colon;
-    std::string rest = key ? t.substr(colon + 1) : t;
-    if (key && rest.find("!!opencv-matrix") != std::string::npos) continue;
-    // A quoted text value (OpenCV's calibration sample writes calibration_time: "Thu Dec  4 …").
-    const size_t q0 = rest.find('"');
-    if (key && q0 != std::string::npos && rest.find('"', q0 + 1) == rest.find_last_of('"') &&
-        rest.find_last_of('"') > q0 && rest.find_first_not_of(" \t") == q0 &&
-        rest.find_first_not_of(" \t", rest.find_last_of('"') + 1) == std::string::npos)
-      continue;
-    // A value or a data line: numbers, with the brackets and commas of a sequence, or a word value
-    // (dt: d, a calibration's date).
-    bool ok = true;
-    std::string token;
-    int words = 0;
-    for (size_t i = 0; i <= rest.size(); ++i) {
-      const char c = i < rest.size() ? rest[i] : ' ';
-      if (c == ' ' || c == '\t' || c == ',' || c == '[' || c == ']') {
-        if (!token.empty() && !number(token)) {
-          ok = key && token.find_first_of("-:[]{}") == std::string::npos;
-          ++words;
-        }
-        if (!ok) break;
-        token.clear();
-      } else {
-        token += c;
-      }
-    }
-    if (!ok || (!key && words > 0) || (key && rest.find_first_of("{}\"'") != std::string::npos)) {
-      throw std::runtime_error(path + ": line " + std::to_string(line_no) + ": '" + t.substr(0, 80) +
-                               "' is not a line of an OpenCV camera file");
     }
   }
 }

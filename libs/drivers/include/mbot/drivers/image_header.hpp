@@ -1,4 +1,4 @@
-// An image file's size and completeness from its header, before any decoder allocates for it: a
+// An image file's size and completeness, checked from its header before any decoder allocates for it: a
 // PNG whose header claims 20000 × 20000 pixels, a 60000² JPEG or a JPEG cut short is refused
 // naming the file, instead of an allocation failure or a silent half image.
 #pragma once
@@ -13,17 +13,12 @@ namespace mbot::drivers {
 constexpr int64_t kMaxImagePixels = int64_t{1} << 26;
 constexpr int kMaxImageSidePx = 32768;
 
-struct ImageHeader {
-  std::string format;         // "png", "jpeg", "bmp", "pnm", "tiff"
-  int width = 0, height = 0;  // 0 when the format's size is not read here (TIFF)
-};
-
 // Reads the image file at `path` (its header and its last bytes decide) and throws std::runtime_error naming the file
 // when it is no image of a known kind (PNG, JPEG, BMP, PNM, TIFF), claims a size of 0 or beyond the limits above, or is
 // cut short (a JPEG without its end-of-image marker, a PNG without its IEND chunk).
-ImageHeader CheckImageFile(const std::string& path);
+void CheckImageFile(const std::string& path);
 
 // The same for the bytes of a file, `name` naming it in errors.
-ImageHeader CheckImageBytes(const std::string& bytes, const std::string& name);
+void CheckImageBytes(const std::string& bytes, const std::string& name);
 
 }  // namespace mbot::drivers

@@ -57,16 +57,10 @@ CalibrationResult CalibrateChessboard(const std::vector<std::pair<std::string, c
 // the board and flags), written whole or not at all.
 void WriteCameraYaml(const CalibrationResult& r, const ChessboardOptions& o, const std::string& path);
 // Reads camera_matrix, distortion_coefficients, image_width and image_height back; throws naming the
-// file and key when one is missing.
+// file and key when one is missing or cannot be right: a line OpenCV's writer does not make, an image
+// size outside 1-16384 px, a camera matrix with a non-finite element, a last row other than 0 0 1 or
+// a focal length not in (0, 100 × the longer side], distortion that is not 0, 4, 5, 8, 12 or 14
+// finite values (returned as one row of doubles).
 CalibrationResult ReadCameraYaml(const std::string& path);
-
-// The largest image side a camera file may give [px].
-constexpr int kMaxCameraSidePx = 16384;
-
-// Refuses a camera that cannot be right, naming `path` and the key: an image size outside
-// 1-kMaxCameraSidePx, a camera matrix with a non-finite element, a last row other than 0 0 1 or a
-// focal length not in (0, 100 × the longer side], distortion that is not 0, 4, 5, 8, 12 or 14 finite
-// values. The distortion comes back as one row of doubles.
-void ValidateCamera(CalibrationResult& r, const std::string& path);
 
 }  // namespace mbot::vision
