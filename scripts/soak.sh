@@ -2,10 +2,10 @@
 # The one-hour soak (config/soak.ini: an hour of simulated time in one process — exploration with
 # full SLAM, then Warehouse rounds on the map it made), then its
 # curves from slam_scans.csv: per 5 simulated minutes, the median and 95th-percentile time per scan
-# and the resident memory. Fails when memory grows by more than 64 MB from the first 5 minutes to
-# the last: a buffer that grows with every scan (like the 9.6 KB a scan the consistency metric once
-# kept: 276 MB an hour) fails; the run's own per-scan records (~0.2 KB a scan, kept for its
-# trajectory outputs) do not. Time per scan is reported, not asserted (the machines are shared).
+# and the resident memory. Fails when memory grows by more than 16 MB from the first 5 minutes to
+# the last: a buffer that grows with every scan fails (the 9.6 KB a scan the consistency metric
+# once kept: 276 MB an hour; the per-scan records, before they were streamed to disk: 6.5 MB an
+# hour). Time per scan is reported, not asserted (the machines are shared).
 #   scripts/soak.sh [output dir] [extra mbot_nav arguments]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -38,5 +38,5 @@ awk -F, 'NR > 1 {
     }
     growth = rss[last] - rss[0]
     printf "memory growth from the first 5 minutes to the last: %.1f MB\n", growth
-    if (growth > 64) { print "FAIL: memory is not flat"; exit 1 }
+    if (growth > 16) { print "FAIL: memory is not flat"; exit 1 }
   }' "$out/slam_scans.csv" | tee "$out/soak_curves.txt"

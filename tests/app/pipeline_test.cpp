@@ -37,7 +37,7 @@ TEST(PipelineTest, UnknownStageTypeListsTheKnownOnes) {
              "inspect, lcm_bridge, map_writer, maze_generator, merge_sweep, mission, motor_calibration, "
              "movingai_benchmark, "
              "odometry, "
-             "referee, ros2_bridge, slam, tag_detection, tag_sightings, trajectory_writer)"),
+             "referee, ros2_bridge, sim_fidelity, slam, tag_detection, tag_sightings, trajectory_writer)"),
       std::string::npos)
       << e;
 }

@@ -293,5 +293,46 @@ TEST(TrajectoryError, AlignmentRemovesAKnownRigidTransform) {
   EXPECT_GT(u.xy.rmse, 0.1);
 }
 
+// The streamed (two-pass, raw-moment) alignment against the textbook one — centred sums — written
+// out here, on a noisy path 2 km from the origin (hours of soak or a UTM frame).
+TEST(TrajectoryError, StreamedAlignmentEqualsTheCentredTwoPassFit) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0, 0.02);
+  std::vector<Pose2D> truth, est;
+  const Pose2D t{1.3, -0.7, 0.25};
+  for (int i = 0; i < 5000; ++i) {
+    const Pose2D p{2000 + 10 * std::cos(i * 0.003), -1500 + 6 * std::sin(i * 0.005), i * 0.01};
+    truth.push_back(p);
+    est.push_back(t.Inverse().Compose(Pose2D{p.x + noise(rng), p.y + noise(rng), p.theta + noise(rng)}));
+  }
+  double ex = 0, ey = 0, tx = 0, ty = 0;
+  for (size_t i = 0; i < est.size(); ++i) ex += est[i].x, ey += est[i].y, tx += truth[i].x, ty += truth[i].y;
+  ex /= est.size(), ey /= est.size(), tx /= est.size(), ty /= est.size();
+  double sxx = 0, sxy = 0;
+  for (size_t i = 0; i < est.size(); ++i) {
+    const double ax = est[i].x - ex, ay = est[i].y - ey, bx = truth[i].x - tx, by = truth[i].y - ty;
+    sxx += ax * bx + ay * by, sxy += ax * by - ay * bx;
+  }
+  const double theta = std::atan2(sxy, sxx);
+  const Pose2D want{tx - (std::cos(theta) * ex - std::sin(theta) * ey),
+                    ty - (std::sin(theta) * ex + std::cos(theta) * ey), theta};
+  motion::AteAccumulator acc(motion::AteAlignment::kBestFitSE2);
+  for (size_t i = 0; i < est.size(); ++i) acc.AddForAlignment(est[i], truth[i]);
+  for (size_t i = 0; i < est.size(); ++i) acc.AddError(est[i], truth[i]);
+  const motion::AteResult r = acc.Result();
+  EXPECT_NEAR(r.alignment.x, want.x, 1e-6);
+  EXPECT_NEAR(r.alignment.y, want.y, 1e-6);
+  EXPECT_NEAR(r.alignment.theta, want.theta, 1e-10);
+  EXPECT_NEAR(r.alignment.theta, 0.25, 0.01);
+  double sq = 0;
+  for (size_t i = 0; i < est.size(); ++i) {
+    const Pose2D a = want.Compose(est[i]);
+    sq += (a.x - truth[i].x) * (a.x - truth[i].x) + (a.y - truth[i].y) * (a.y - truth[i].y);
+  }
+  EXPECT_NEAR(r.xy.rmse, std::sqrt(sq / est.size()), 1e-9);
+  EXPECT_EQ(r.samples, 5000);
+  EXPECT_THROW(motion::AteAccumulator(motion::AteAlignment::kFirstPose).Result(), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace mbot::mapping

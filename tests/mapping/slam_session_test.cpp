@@ -74,6 +74,24 @@ TEST(SlamInputs, StampsThatShareTheLogsClockPlaceTheirMessagesAndOthersKeepTheir
   EXPECT_EQ(in.odometry()[1].t_us, 1'100'000);
 }
 
+// The `mixed` fault run: a corrupt stamp 0.6 s ahead (under the 2 s that marks a stamp absurd) held
+// the odometry back until real stamps passed it, and the turn across that hole read as a restart.
+TEST(SlamInputs, AStampWellAheadOfItsChannelsUsualLagIsDropped) {
+  SlamSessionOptions o;
+  o.time_base = "auto";
+  SlamInputs in(o, 1);
+  for (int k = 0; k < 10; ++k)
+    in.Add(Odometry(1'000'000 + k * 20'000, 0.01 * k, "MBOT_ODOMETRY", 990'000 + k * 20'000));
+  ASSERT_EQ(in.odometry().size(), 10u);
+  EXPECT_FALSE(in.Add(Odometry(1'200'000, 0.1, "MBOT_ODOMETRY", 1'790'000)));  // 0.6 s ahead: dropped
+  EXPECT_TRUE(in.Add(Odometry(1'220'000, 0.11, "MBOT_ODOMETRY", 1'210'000)));  // the next one is placed
+  ASSERT_EQ(in.odometry().size(), 11u);
+  EXPECT_EQ(in.odometry().back().t_us, 1'210'000);
+  // A message that arrived late (a stalled link) is older, not corrupt: placed at its stamp.
+  EXPECT_TRUE(in.Add(Odometry(1'700'000, 0.12, "MBOT_ODOMETRY", 1'230'000)));
+  EXPECT_EQ(in.odometry().back().t_us, 1'230'000);
+}
+
 TEST(SlamInputs, EncoderTicksIntegrateToOdometry) {
   SlamSessionOptions o;
   o.encoder_odometry = true;
@@ -127,7 +145,7 @@ TEST(SlamSession, PublishesThePoseEveryScanTheStatusOnChangeAndTheMapEveryKthSca
   session.Add(Odometry(1'300'000, 0.26), &out);
   session.Finish(&out);
   count();
-  const size_t scans = session.records().size();
+  const size_t scans = session.scans_processed();
   EXPECT_EQ(scans, 12u);
   EXPECT_EQ(poses, 12);
   EXPECT_EQ(statuses, 1);                                   // "mapping", once
@@ -136,7 +154,61 @@ TEST(SlamSession, PublishesThePoseEveryScanTheStatusOnChangeAndTheMapEveryKthSca
   EXPECT_EQ(session.particle_snapshots().size(), 3u * 50);  // scans 1, 5, 9
   EXPECT_EQ(session.skipped_scans(), 0);
   // The robot drove 0.22 m along x: SLAM follows.
-  EXPECT_NEAR(session.records().back().slam.x, 0.22, 0.05);
+  EXPECT_NEAR(session.last_record()->slam.x, 0.22, 0.05);
+}
+
+TEST(SlamSession, RecordsStreamOutAsTheirTruthArrivesSoALongRunHoldsFew) {
+  SlamSessionOptions o;
+  o.slam.mode = SlamMode::kFullSlam;
+  o.slam.filter.particles = 20;
+  SlamSession session(o, 3, std::nullopt);
+  std::vector<mapping::ScanRecord> got;
+  size_t most_held = 0;
+  session.StreamRecords([&](const ScanRecord& r) { got.push_back(r); });
+  std::vector<Event> out;
+  for (int k = 0; k < 400; ++k) {
+    const double x = 0.001 * k;
+    session.Add(Odometry(k * 100'000, x), &out);
+    session.Add(Event{k * 100'000 + 20'000, 0, "TRUE_POSE", EventKind::kGroundTruth, msgs::Pose2D{x, 0.5, 0}}, &out);
+    session.Add(Scan(k * 100'000 + 50'000, x), &out);
+    most_held = std::max(most_held, session.records().size());
+  }
+  // Streamed during the run, not at its end. No reference series ever started, so a record waits
+  // for one until it is 4 × max_pose_gap_s + 1 s = 3 s old: ~30 scans held, however long the run.
+  EXPECT_GT(got.size(), 360u);
+  EXPECT_LE(most_held, 32u);
+  session.Finish(&out);
+  ASSERT_EQ(got.size(), session.scans_processed());
+  EXPECT_TRUE(session.records().empty());
+  for (size_t i = 0; i < got.size(); ++i) {
+    if (i > 0) {
+      EXPECT_GT(got[i].t_us, got[i - 1].t_us);
+    }
+    ASSERT_TRUE(got[i].truth) << "record " << i;
+    EXPECT_NEAR(got[i].truth->y, 0.5, 1e-9);
+  }
+}
+
+TEST(SlamSession, RecordsWaitForATruthThatStoppedOnlyAFewSeconds) {
+  SlamSessionOptions o;
+  o.slam.mode = SlamMode::kFullSlam;
+  o.slam.filter.particles = 20;
+  SlamSession session(o, 3, std::nullopt);
+  size_t released = 0, with_truth = 0;
+  session.StreamRecords([&](const ScanRecord& r) { ++released, with_truth += r.truth.has_value(); });
+  std::vector<Event> out;
+  for (int k = 0; k < 300; ++k) {  // the truth stops after 5 s of 30
+    session.Add(Odometry(k * 100'000, 0.001 * k), &out);
+    if (k < 50) session.Add(Event{k * 100'000, 0, "TRUE_POSE", EventKind::kGroundTruth, msgs::Pose2D{}}, &out);
+    session.Add(Scan(k * 100'000 + 50'000, 0.001 * k), &out);
+  }
+  // max_pose_gap_s = 0.5: a record is given up 4 × 0.5 + 1 = 3 s behind the newest scan.
+  EXPECT_LE(session.records().size(), 32u);
+  EXPECT_GE(released, 260u);
+  session.Finish(&out);
+  EXPECT_EQ(released, session.scans_processed());
+  EXPECT_GE(with_truth, 50u);
+  EXPECT_LE(with_truth, 55u);  // the last truth pose holds for max_pose_gap_s
 }
 
 TEST(SlamSession, ACheckpointIsDueEveryIntervalOfTheStreamsTime) {

@@ -80,6 +80,38 @@ TEST(Slam, FullSlamCorrectsDriftingOdometryWithItsOwnMap) {
   EXPECT_GT(std::abs(odometry.theta), 5.0 * M_PI / 180);
 }
 
+// A corrupt scan on a faulty bus (its stamp off, so it is placed where the robot was not): one
+// whose fit to the map collapses is not mapped, and the map keeps no room that is not there. A run
+// of them longer than gate_max_scans is mapped (the map must follow a world that changed).
+TEST(Slam, FullSlamDoesNotMapAScanWhoseFitCollapses) {
+  const Room room;
+  Slam slam(Options(SlamMode::kFullSlam), 3);
+  slam.Initialize({-0.5, -0.5, 0}, {-0.5, -0.5, 0});
+  Pose2D truth;
+  for (int i = 0; i <= 14; ++i) {
+    truth = {-0.5 + 0.05 * i, -0.5, 0.0};
+    EXPECT_FALSE(slam.ProcessScan(MarchScan(room.map, truth), truth).gated);
+  }
+  const OccupancyGrid before = slam.map();
+  const Pose2D elsewhere{0.9, 0.6, 1.2};  // what the corrupt scan saw, from where it really was
+  const SlamStep bad = slam.ProcessScan(MarchScan(room.map, elsewhere), truth);
+  EXPECT_TRUE(bad.gated);
+  EXPECT_EQ(slam.map(), before);
+  EXPECT_EQ(slam.scans_gated(), 1);
+  EXPECT_FALSE(slam.ProcessScan(MarchScan(room.map, truth), truth).gated);  // the next good one is mapped
+  for (int k = 0; k < 3; ++k) EXPECT_TRUE(slam.ProcessScan(MarchScan(room.map, elsewhere), truth).gated);
+  EXPECT_FALSE(slam.ProcessScan(MarchScan(room.map, elsewhere), truth).gated);  // the fourth in a row
+  EXPECT_EQ(slam.scans_gated(), 4);
+  // Off, nothing is gated.
+  SlamOptions off = Options(SlamMode::kFullSlam);
+  off.gate_fit_ratio = 0;
+  Slam plain(off, 3);
+  plain.Initialize({-0.5, -0.5, 0}, {-0.5, -0.5, 0});
+  for (int i = 0; i <= 14; ++i)
+    plain.ProcessScan(MarchScan(room.map, {-0.5 + 0.05 * i, -0.5, 0.0}), {-0.5 + 0.05 * i, -0.5, 0.0});
+  EXPECT_FALSE(plain.ProcessScan(MarchScan(room.map, elsewhere), truth).gated);
+}
+
 TEST(Slam, ActionOnlyFollowsOdometry) {
   const Room room;
   Slam slam(Options(SlamMode::kActionOnly), 1);

@@ -59,5 +59,36 @@ TEST(OdometryContinuity, OneCorruptMessageIsDropped) {
   EXPECT_EQ(c.outliers(), 2);
 }
 
+// The fault relay's `mixed` run: a corrupt message, then its duplicate. The copy agreed with the
+// jump and made it a restart, and the map grew a room outside the maze.
+TEST(OdometryContinuity, ADuplicateOfACorruptMessageConfirmsNothing) {
+  OdometryContinuity c;
+  c.Update(0, {1.0, 2.0, 0.1});
+  c.Update(20'000, {1.004, 2.0, 0.1});
+  EXPECT_NEAR(c.Update(40'000, {1.604, 2.0, 0.1}).x, 1.004, 1e-12);  // corrupt: held
+  EXPECT_NEAR(c.Update(40'000, {1.604, 2.0, 0.1}).x, 1.004, 1e-12);  // its duplicate: still held
+  EXPECT_NEAR(c.Update(60'000, {1.012, 2.0, 0.1}).x, 1.012, 1e-12);  // back: it was corrupt
+  EXPECT_EQ(c.restarts(), 0);
+  EXPECT_EQ(c.duplicates(), 1);
+  // A real restart is still one: the next, later message agrees with the jump.
+  c.Update(80'000, {0.0, 0.0, 0.0});
+  c.Update(80'000, {0.0, 0.0, 0.0});
+  const Pose2D p = c.Update(100'000, {0.0, 0.0, 0.0});
+  EXPECT_EQ(c.restarts(), 1);
+  EXPECT_NEAR(p.x, 1.012, 1e-12);
+}
+
+// The mission places messages at their arrival: a duplicate arrives later, but carries the stamp.
+TEST(OdometryContinuity, ADuplicateIsKnownByItsStampWhenTimesAreArrivals) {
+  OdometryContinuity c;
+  c.Update(0, {1.0, 2.0, 0.1}, 500);
+  c.Update(20'000, {1.004, 2.0, 0.1}, 520);
+  c.Update(41'000, {1.604, 2.0, 0.1}, 540);                               // corrupt
+  EXPECT_NEAR(c.Update(43'000, {1.604, 2.0, 0.1}, 540).x, 1.004, 1e-12);  // its copy, 2 ms later
+  EXPECT_NEAR(c.Update(61'000, {1.012, 2.0, 0.1}, 560).x, 1.012, 1e-12);
+  EXPECT_EQ(c.restarts(), 0);
+  EXPECT_EQ(c.duplicates(), 1);
+}
+
 }  // namespace
 }  // namespace mbot::motion

@@ -82,6 +82,27 @@ TEST(SimRobot, DrivesStraightAtTheCommandedSpeed) {
   EXPECT_EQ(robot.collisions(), 0);
 }
 
+// The firmware's gate on a faulty bus: a command beyond its limits (a corrupt one: 1e5 m/s, NaN) is
+// refused, and the last good command holds.
+TEST(SimRobot, RefusesCommandsBeyondTheFirmwaresLimits) {
+  World world = Box(3.0);
+  SimRobot robot(world, SimRobotOptions{}, {-1.5, 0, 0}, 1);
+  std::vector<Event> out;
+  EXPECT_TRUE(robot.Command(0.2, 0.0));
+  robot.AdvanceTo(kSecond, &out);
+  EXPECT_FALSE(robot.Command(1e5, 0.0));
+  EXPECT_FALSE(robot.Command(0.2, NAN));
+  EXPECT_FALSE(robot.Command(-0.81, 0.0));  // MAX_FWD_VEL 0.8 m/s
+  EXPECT_FALSE(robot.Command(0.2, 2.6));    // MAX_TURN_VEL 2.5 rad/s
+  EXPECT_TRUE(robot.Command(0.8, -2.5));    // at the limits
+  EXPECT_TRUE(robot.Command(0.2, 0.0));
+  robot.AdvanceTo(2 * kSecond, &out);
+  EXPECT_EQ(robot.commands_refused(), 4);
+  // Driven at 0.2 m/s throughout: the refused commands changed nothing.
+  EXPECT_GT(robot.distance_travelled_m(), 0.3);
+  EXPECT_LT(robot.distance_travelled_m(), 0.42);
+}
+
 TEST(SimRobot, TurnsInPlace) {
   World world = Box(2.0);
   SimRobot robot(world, SimRobotOptions{}, {0, 0, 0}, 2);

@@ -73,7 +73,8 @@ class MissionStage : public Stage {
         return mission_->OnForklift({f.height_m, f.target_m, f.crate_id, f.carrying});
       }
       case EventKind::kOdometry:
-        for (const mission::MissionOutput& out : mission_->OnOdometry(ev.t_us, std::get<motion::Pose2D>(ev.payload))) {
+        for (const mission::MissionOutput& out :
+             mission_->OnOdometry(ev.t_us, std::get<motion::Pose2D>(ev.payload), ev.stamp_us)) {
           Publish(ev.t_us, out);
         }
         RepeatStatus(ev.t_us);

@@ -20,75 +20,137 @@ using mapping::ScanRecord;
 using motion::Pose2D;
 using motion::TimedPose;
 
-std::vector<Pose2D> PosesOf(const std::vector<TimedPose>& s) {
-  std::vector<Pose2D> v;
-  for (const TimedPose& p : s) v.push_back(p.pose);
-  return v;
-}
-
-void WriteScansCsv(const std::string& path, const std::vector<ScanRecord>& records) {
-  WriteFileAtomically(path, [&](std::ostream& o) {
-    o << "t_s,x,y,theta,filter_updated,particles,ess,spread_m,inlier_fraction,fit_ratio,injected,lost,converged,update_"
-         "ms,rss_mb\n";
-    char line[256];
-    for (const ScanRecord& r : records) {
-      std::snprintf(line, sizeof line, "%.6f,%.4f,%.4f,%.5f,%d,%d,%.1f,%.4f,%.3f,%.3f,%d,%d,%d,%.3f,%.1f\n",
-                    r.t_us * 1e-6, r.slam.x, r.slam.y, r.slam.theta, r.updated, r.status.particles, r.status.ess,
-                    r.status.spread_m, r.status.inlier_fraction, r.status.fit_ratio, r.status.injected, r.status.lost,
-                    r.status.converged, r.update_ms, r.rss_mb);
-      o << line;
-    }
-  });
-}
+std::string TumHeader(const std::string& what) { return "# " + what + ": t x y z qx qy qz qw\n"; }
 
 }  // namespace
 
+SlamRecordWriter::SlamRecordWriter(const std::string& dir, const SlamStageOptions& options)
+    : o_(options),
+      dir_(dir + "/"),
+      truth_name_(options.truth_is_reference ? "reference" : "ground truth"),
+      spool_path_(TempPathFor(dir_ + "slam_records.spool")) {
+  slam_tum_ = std::make_unique<AtomicFileWriter>(dir_ + "slam.tum");
+  slam_tum_->stream() << TumHeader(std::string("SLAM (") + mapping::ToString(options.session.slam.mode) + ")");
+  odometry_tum_ = std::make_unique<AtomicFileWriter>(dir_ + "odometry.tum");
+  odometry_tum_->stream() << TumHeader("odometry at the scan times");
+  scans_csv_ = std::make_unique<AtomicFileWriter>(dir_ + "slam_scans.csv");
+  scans_csv_->stream() << "t_s,x,y,theta,filter_updated,particles,ess,spread_m,inlier_fraction,fit_ratio,injected,"
+                          "lost,converged,update_ms,rss_mb\n";
+  spool_.open(spool_path_, std::ios::binary | std::ios::trunc | std::ios::in | std::ios::out);
+  if (!spool_) throw std::runtime_error(spool_path_ + ": cannot create the slam stage's record spool");
+}
+
+SlamRecordWriter::~SlamRecordWriter() {
+  spool_.close();
+  std::remove(spool_path_.c_str());
+}
+
+void SlamRecordWriter::Add(const ScanRecord& r, int64_t first_t_us) {
+  Spooled sp;
+  sp.t_us = r.t_us;
+  sp.tum_t_us = o_.tum_stamps ? r.stamp_us : r.t_us;
+  sp.latency_us = r.latency_us;
+  sp.slam = r.slam;
+  sp.odometry = r.odometry;
+  sp.updated = r.updated;
+  sp.update_ms = static_cast<float>(r.update_ms);
+  sp.ess = static_cast<float>(r.status.ess);
+  slam_tum_->stream() << TumLine(sp.tum_t_us * 1e-6, r.slam.x, r.slam.y, r.slam.theta);
+  odometry_tum_->stream() << TumLine(sp.tum_t_us * 1e-6, r.odometry.x, r.odometry.y, r.odometry.theta);
+  char line[256];
+  std::snprintf(line, sizeof line, "%.6f,%.4f,%.4f,%.5f,%d,%d,%.1f,%.4f,%.3f,%.3f,%d,%d,%d,%.3f,%.1f\n", r.t_us * 1e-6,
+                r.slam.x, r.slam.y, r.slam.theta, r.updated, r.status.particles, r.status.ess, r.status.spread_m,
+                r.status.inlier_fraction, r.status.fit_ratio, r.status.injected, r.status.lost, r.status.converged,
+                r.update_ms, r.rss_mb);
+  scans_csv_->stream() << line;
+  // Each scan's pose against the truth at its time: within the scoring window and not too late.
+  const std::optional<Pose2D>& truth = o_.truth_is_reference ? r.reference : r.truth;
+  if (truth) {
+    sp.has_truth = 1;
+    sp.truth = *truth;
+    if (!truth_tum_) {
+      truth_tum_ = std::make_unique<AtomicFileWriter>(dir_ + "ground_truth.tum");
+      truth_tum_->stream() << TumHeader(truth_name_ + " at the scan times");
+    }
+    truth_tum_->stream() << TumLine(sp.tum_t_us * 1e-6, truth->x, truth->y, truth->theta);
+    const bool late = o_.score_max_latency_us > 0 && r.latency_us > o_.score_max_latency_us;
+    unscored_late_ += late;
+    sp.scored = r.t_us >= o_.score_from_us + first_t_us && !late;
+    if (sp.scored && !o_.truth_is_reference && r.reference) sp.has_reference = 1, sp.reference = *r.reference;
+  }
+  spool_.write(reinterpret_cast<const char*>(&sp), sizeof sp);
+  if (!spool_) throw std::runtime_error(spool_path_ + ": write failed (disk full?)");
+  ++records_;
+}
+
+void SlamRecordWriter::Commit() {
+  spool_.flush();
+  if (!spool_) throw std::runtime_error(spool_path_ + ": write failed (disk full?)");
+  slam_tum_->Commit();
+  odometry_tum_->Commit();
+  scans_csv_->Commit();
+  if (truth_tum_) truth_tum_->Commit();
+}
+
+void SlamRecordWriter::ForEach(const std::function<void(const Spooled&)>& f) const {
+  std::ifstream in(spool_path_, std::ios::binary);
+  Spooled sp;
+  size_t n = 0;
+  while (n < records_ && in.read(reinterpret_cast<char*>(&sp), sizeof sp)) f(sp), ++n;
+  if (n != records_) {
+    throw std::runtime_error(spool_path_ + ": read back " + std::to_string(n) + " of " + std::to_string(records_) +
+                             " records");
+  }
+}
+
 void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamStageOptions& options,
-                      const mapping::SlamSession& session, double wall_s) {
-  const std::vector<ScanRecord>& records = session.records();
+                      const mapping::SlamSession& session, SlamRecordWriter& records, double wall_s) {
+  records.Commit();
   const mapping::SlamInputs& inputs = session.inputs();
-  const std::vector<TimedPose>& reference = inputs.reference();
-  const std::vector<TimedPose>& ground_truth = inputs.ground_truth();
   const std::vector<mapping::ScanSample::Item>& scan_points = session.scan_points();
   const int64_t first_t_us = inputs.first_t_us(), last_t_us = inputs.last_t_us();
   const std::string dir = ctx.output_dir + "/";
-  const int64_t max_gap = static_cast<int64_t>(options.session.max_pose_gap_s * 1e6);
-  const std::vector<TimedPose>& truth_series = options.truth_is_reference ? reference : ground_truth;
   const std::string truth_name = options.truth_is_reference ? "reference" : "ground truth";
+  using Spooled = SlamRecordWriter::Spooled;
+  using motion::AteAccumulator;
+  using motion::AteAlignment;
 
-  // Each scan's pose against the truth at its time: within the scoring window and not too late.
-  std::vector<TimedPose> slam_path, odometry_path, truth_path;
-  int unscored_late = 0;
-  std::vector<Pose2D> est_paired, odo_paired, truth_paired, ref_paired, ref_truth_paired;
-  for (const ScanRecord& r : records) {
-    const int64_t tum_t = options.tum_stamps ? r.stamp_us : r.t_us;
-    slam_path.push_back({tum_t, r.slam});
-    odometry_path.push_back({tum_t, r.odometry});
-    Pose2D t;
-    const std::optional<Pose2D>& kept = options.truth_is_reference ? r.reference : r.truth;
-    if (kept) {
-      t = *kept;
-    } else if (!motion::InterpolateAt(truth_series, r.t_us, max_gap, &t)) {
-      continue;
+  // The scores, read back from the spool in two passes: the alignments, then the errors.
+  struct Scored {
+    std::vector<AteAccumulator> slam, odometry, reference;  // aligned, anchored, unaligned
+  } acc;
+  for (auto* v : {&acc.slam, &acc.odometry, &acc.reference})
+    for (AteAlignment a : {AteAlignment::kBestFitSE2, AteAlignment::kFirstPose, AteAlignment::kNone})
+      v->emplace_back(a);
+  std::vector<Pose2D> slam_path, odometry_path, truth_path;  // the PNG's (read back, freed at the end)
+  std::vector<double> update_ms, filter_ms, ess;
+  std::vector<motion::TimedPose> relation_path;
+  int updates = 0;
+  records.ForEach([&](const Spooled& r) {
+    slam_path.push_back(r.slam);
+    odometry_path.push_back(r.odometry);
+    if (r.has_truth) truth_path.push_back(r.truth);
+    update_ms.push_back(r.update_ms);
+    if (r.updated) ++updates, filter_ms.push_back(r.update_ms), ess.push_back(r.ess);
+    if (!options.relations_file.empty()) relation_path.push_back({r.tum_t_us, r.slam});
+    if (!r.scored) return;
+    for (int k = 0; k < 3; ++k) {
+      acc.slam[k].AddForAlignment(r.slam, r.truth);
+      acc.odometry[k].AddForAlignment(r.odometry, r.truth);
+      if (r.has_reference) acc.reference[k].AddForAlignment(r.reference, r.truth);
     }
-    truth_path.push_back({tum_t, t});
-    const bool late = options.score_max_latency_us > 0 && r.latency_us > options.score_max_latency_us;
-    unscored_late += late;
-    if (r.t_us < options.score_from_us + first_t_us || late) continue;
-    est_paired.push_back(r.slam);
-    odo_paired.push_back(r.odometry);
-    truth_paired.push_back(t);
-    Pose2D ref;
-    if (!options.truth_is_reference &&
-        (r.reference ? (ref = *r.reference, true) : motion::InterpolateAt(reference, r.t_us, max_gap, &ref))) {
-      ref_paired.push_back(ref);
-      ref_truth_paired.push_back(t);
+  });
+  records.ForEach([&](const Spooled& r) {
+    if (!r.scored) return;
+    for (int k = 0; k < 3; ++k) {
+      acc.slam[k].AddError(r.slam, r.truth);
+      acc.odometry[k].AddError(r.odometry, r.truth);
+      if (r.has_reference) acc.reference[k].AddError(r.reference, r.truth);
     }
-  }
-  WriteTum(dir + "slam.tum", std::string("SLAM (") + mapping::ToString(options.session.slam.mode) + ")", slam_path);
-  WriteTum(dir + "odometry.tum", "odometry at the scan times", odometry_path);
-  WriteScansCsv(dir + "slam_scans.csv", records);
-  if (!truth_path.empty()) WriteTum(dir + "ground_truth.tum", truth_name + " at the scan times", truth_path);
+  });
+  auto errors = [](const std::vector<AteAccumulator>& a) {
+    return motion::TrajectoryErrors{a[0].Result(), a[1].Result(), a[2].Result()};
+  };
 
   const mapping::GraphSlam* graph = session.slam().graph();
   std::optional<mapping::OccupancyGrid> rendered;
@@ -104,10 +166,11 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamStageOp
   std::vector<drivers::MapOverlay> overlays;
   if (!session.particle_snapshots().empty())
     overlays.push_back({session.particle_snapshots(), 255, 160, 0, true, "particles"});
-  if (!truth_path.empty()) overlays.push_back({PosesOf(truth_path), 0, 170, 0, false, truth_name});
-  overlays.push_back({PosesOf(odometry_path), 220, 0, 0, false, "odometry"});
-  overlays.push_back({PosesOf(slam_path), 0, 60, 255, false, "SLAM"});
+  if (!truth_path.empty()) overlays.push_back({std::move(truth_path), 0, 170, 0, false, truth_name});
+  overlays.push_back({std::move(odometry_path), 220, 0, 0, false, "odometry"});
+  overlays.push_back({std::move(slam_path), 0, 60, 255, false, "SLAM"});
   drivers::WriteMapPngWithOverlays(map, overlays, options.png_scale, base + ".png");
+  overlays.clear();
 
   // Map sharpness: the share of every scan's returns that end within inlier_distance_m of an
   // obstacle of the final map, at the pose the scan was given (blurred or doubled walls lower it).
@@ -117,14 +180,8 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamStageOp
     model.SetMap(map);
     double sum = 0;
     for (size_t i = 0; i < scan_points.size(); ++i)
-      sum += model.InlierFraction(records[scan_points[i].index].slam, scan_points[i].value);
+      sum += model.InlierFraction(scan_points[i].value.pose, scan_points[i].value.points);
     consistency = sum / scan_points.size();
-  }
-  std::vector<double> update_ms, filter_ms, ess;
-  int updates = 0;
-  for (const ScanRecord& r : records) {
-    update_ms.push_back(r.update_ms);
-    if (r.updated) ++updates, filter_ms.push_back(r.update_ms), ess.push_back(r.status.ess);
   }
   const double data_s = (last_t_us - first_t_us) * 1e-6;
   reports::Json j;
@@ -132,19 +189,21 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamStageOp
   j["seed"] = ctx.seed;
   j["interrupted"] = interrupted;
   j["source"] = ctx.source_path;
-  j["scans"] = records.size();
+  j["scans"] = records.records();
   j["scans_skipped"] = session.skipped_scans();
+  j["scans_gated"] = session.slam().scans_gated();
   j["filter_updates"] = updates;
   j["particles"] = options.session.slam.filter.particles;
-  j["truth"] = truth_series.empty() ? "none" : truth_name;
-  j["scans_not_scored_late"] = unscored_late;
-  if (!est_paired.empty()) {
-    const motion::TrajectoryErrors slam_errors = motion::EvaluateTrajectory(est_paired, truth_paired);
-    const motion::TrajectoryErrors odo_errors = motion::EvaluateTrajectory(odo_paired, truth_paired);
+  const bool any_truth =
+      records.has_truth() || !(options.truth_is_reference ? inputs.reference() : inputs.ground_truth()).empty();
+  j["truth"] = any_truth ? truth_name : "none";
+  j["scans_not_scored_late"] = records.unscored_late();
+  if (acc.slam[0].samples() > 0) {
+    const motion::TrajectoryErrors slam_errors = errors(acc.slam);
+    const motion::TrajectoryErrors odo_errors = errors(acc.odometry);
     j["slam_ate"] = reports::TrajectoryErrorsJson(slam_errors);
     j["odometry_ate"] = reports::TrajectoryErrorsJson(odo_errors);
-    if (!ref_paired.empty())
-      j["reference_ate"] = reports::TrajectoryErrorsJson(motion::EvaluateTrajectory(ref_paired, ref_truth_paired));
+    if (acc.reference[0].samples() > 0) j["reference_ate"] = reports::TrajectoryErrorsJson(errors(acc.reference));
     const motion::AteResult& a = slam_errors.aligned;
     const motion::AteResult& o = odo_errors.aligned;
     mbot::log::Info("slam: ATE vs " + truth_name + " (aligned, " + std::to_string(a.samples) + " scans): RMSE x " +
@@ -159,7 +218,7 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamStageOp
   // A relations file that does not fit the run is an error, but only once everything else is written.
   std::string relations_error;
   if (!options.relations_file.empty())
-    j["relations"] = RelationsJson(options.relations_file, slam_path, &relations_error);
+    j["relations"] = RelationsJson(options.relations_file, relation_path, &relations_error);
   const mapping::SlamEventTracker& ev = session.events();
   j["global_localization"] = nullptr;
   if (ev.global()) {
@@ -194,7 +253,7 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamStageOp
               {"origin_x", reports::Number(map.origin_x())},
               {"origin_y", reports::Number(map.origin_y())}};
   reports::WriteJson(dir + "metrics.json", j);
-  mbot::log::Info("slam: " + std::to_string(records.size()) + " scans (" + std::to_string(updates) +
+  mbot::log::Info("slam: " + std::to_string(records.records()) + " scans (" + std::to_string(updates) +
                   " filter updates), scan consistency " + Num(consistency, 3) + ", median " +
                   Num(reports::SampleStats::Of(update_ms).median, 3) + " ms per scan; outputs in " + ctx.output_dir);
   if (!relations_error.empty()) throw motion::RelationsError(relations_error);

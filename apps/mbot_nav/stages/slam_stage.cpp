@@ -33,6 +33,9 @@ class SlamStage : public Stage {
                       "x" + std::to_string(known->height()) + ")");
     }
     session_.emplace(options_.session, ctx.seed, std::move(known));
+    records_.emplace(ctx.output_dir, options_);
+    session_->StreamRecords(
+        [this](const mapping::ScanRecord& r) { records_->Add(r, session_->inputs().first_t_us()); });
     wall_start_ = std::chrono::steady_clock::now();
     if (!options_.resume_from.empty()) {
       mbot::log::Info("slam: resuming from checkpoint " + options_.resume_from + " at (" +
@@ -62,7 +65,7 @@ class SlamStage : public Stage {
     session_->Finish(&out_);
     Emit();
     const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
-    if (session_->records().empty()) {
+    if (session_->scans_processed() == 0) {
       const std::string why = mapping::NoScanProcessedReason(*session_);
       // A run stopped before its first scan has nothing to say; one that read its whole input failed.
       if (interrupted) {
@@ -71,7 +74,7 @@ class SlamStage : public Stage {
       }
       throw std::runtime_error("slam: " + why);
     }
-    WriteSlamOutputs(ctx, interrupted, options_, *session_, wall_s);
+    WriteSlamOutputs(ctx, interrupted, options_, *session_, *records_, wall_s);
   }
 
  private:
@@ -83,6 +86,7 @@ class SlamStage : public Stage {
 
   SlamStageOptions options_;
   std::optional<mapping::SlamSession> session_;
+  std::optional<SlamRecordWriter> records_;  // the per-scan outputs, streamed to disk
   std::vector<msgs::Event> out_;
   Bus* bus_ = nullptr;
   std::chrono::steady_clock::time_point wall_start_;

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <stdexcept>
 #include <system_error>
+#include <utility>
 
 namespace fs = std::filesystem;
 
@@ -46,6 +47,31 @@ void WriteFileAtomically(const std::string& path, const std::function<void(std::
     }
   }
   CommitFile(tmp, path);
+}
+
+AtomicFileWriter::AtomicFileWriter(std::string path)
+    : path_(std::move(path)), tmp_(TempPathFor(path_)), out_(tmp_, std::ios::binary | std::ios::trunc) {
+  if (!out_) throw std::runtime_error(path_ + ": cannot create file");
+}
+
+AtomicFileWriter::~AtomicFileWriter() {
+  if (committed_) return;
+  out_.close();
+  std::remove(tmp_.c_str());
+}
+
+void AtomicFileWriter::Commit() {
+  if (committed_) return;
+  out_.flush();
+  const bool good = static_cast<bool>(out_);
+  out_.close();
+  if (!good) {
+    std::remove(tmp_.c_str());
+    committed_ = true;  // nothing left to remove
+    throw std::runtime_error(path_ + ": write failed (disk full?)");
+  }
+  committed_ = true;
+  CommitFile(tmp_, path_);
 }
 
 void EnsureDirectory(const std::string& dir) {

@@ -245,6 +245,15 @@ SlamOptions ParseSlamOptions(config::Section& s) {
   m.action = ParseActionModelOptions(s);
   m.sensor = ParseSensorModelOptions(s);
   m.filter = ParseParticleFilterOptions(s, m.mode);
+  if (m.mode == SlamMode::kFullSlam || s.describing()) {  // the gate's keys exist where it works
+    m.gate_fit_ratio = s.GetDouble("gate_fit_ratio", m.gate_fit_ratio,
+                                   "full SLAM: a scan fitting the map at under this share of the recent mapped "
+                                   "scans' median fit (corrupt, misplaced) is not mapped (0: off)",
+                                   0.0, 1.0);
+    m.gate_max_scans =
+        static_cast<int>(s.GetInt("gate_max_scans", m.gate_max_scans,
+                                  "... at most this many in a row: the next is mapped whatever it fits", 0, 1000));
+  }
   // The graph keys exist in graph_slam mode only (elsewhere they are unknown keys); --list-stages
   // documents them too.
   if (m.mode == SlamMode::kGraphSlam || s.describing()) m.graph = ParseGraphSlamOptions(s);

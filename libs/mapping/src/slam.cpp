@@ -2,6 +2,7 @@
 
 #include "mbot/common/strings.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace mbot::mapping {
@@ -102,10 +103,36 @@ SlamStep Slam::ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2
   out.status = filter_.status();
   out.pose = last_estimate_.Compose(last_odometry_.Inverse().Compose(odometry));
   if (options_.mode != SlamMode::kLocalization && mapping_on_) {
-    mapper_.Insert(rays, out.pose);
-    sensor_stale_ = true;
+    out.gated = options_.mode == SlamMode::kFullSlam && Gate(rays, out.pose);
+    if (!out.gated) {
+      mapper_.Insert(rays, out.pose);
+      sensor_stale_ = true;
+    }
   }
   return out;
+}
+
+bool Slam::Gate(const std::vector<ScanRay>& rays, const motion::Pose2D& pose) {
+  constexpr size_t kHistory = 15, kMinHistory = 10;
+  // The map the sensor model holds may be a few scans old (it is rebuilt at filter updates): for
+  // telling a collapse from a fit, that is the same map.
+  if (options_.gate_fit_ratio <= 0 || !sensor_.has_map()) return false;
+  const ScanPoints points = sensor_.Prepare(rays);
+  if (points.size() == 0) return false;
+  const double fit = sensor_.InlierFraction(pose, points);
+  if (recent_fits_.size() >= kMinHistory && gated_in_row_ < options_.gate_max_scans) {
+    std::vector<double> v(recent_fits_.begin(), recent_fits_.end());
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    if (fit < options_.gate_fit_ratio * v[v.size() / 2]) {
+      ++gated_in_row_;
+      ++scans_gated_;
+      return true;
+    }
+  }
+  gated_in_row_ = 0;
+  recent_fits_.push_back(fit);
+  if (recent_fits_.size() > kHistory) recent_fits_.pop_front();
+  return false;
 }
 
 void Slam::SetMapping(bool on) {

@@ -132,7 +132,9 @@ bool SlamInputs::Add(const msgs::Event& in) {
   if (first_t_us_ < 0) first_t_us_ = in.t_us;
   last_t_us_ = in.t_us;
   msgs::Event retimed;
-  const msgs::Event& ev = Retime(in, &retimed);
+  const msgs::Event* placed = Retime(in, &retimed);
+  if (!placed) return false;
+  const msgs::Event& ev = *placed;
   switch (ev.kind) {
     case EventKind::kOdometry:
       ++odometry_seen_[ev.channel];
@@ -192,15 +194,15 @@ const std::vector<TimedPose>& SlamInputs::poses() const {
 
 // The time each message is placed at: its own stamp when the channel's stamps share the log's
 // clock (the robot's measurement time, immune to network bursts), else its arrival time.
-const msgs::Event& SlamInputs::Retime(const msgs::Event& ev, msgs::Event* copy) {
-  if (o_.time_base == "event" || ev.stamp_us == 0) return ev;
+const msgs::Event* SlamInputs::Retime(const msgs::Event& ev, msgs::Event* copy) {
+  if (o_.time_base == "event" || ev.stamp_us == 0) return &ev;
   auto it = stamp_channels_.find(ev.channel);
   if (it == stamp_channels_.end()) {
     const bool same_clock = o_.time_base == "stamp" || std::llabs(ev.stamp_us - ev.t_us) < 2'000'000;
     it = stamp_channels_.emplace(ev.channel, same_clock).first;
     if (!same_clock) mbot::log::Info("slam: " + ev.channel + " stamps use another clock; using arrival times");
   }
-  if (!it->second) return ev;
+  if (!it->second) return &ev;
   // On a channel whose stamps share the log's clock, a stamp seconds away from the arrival is corrupt:
   // placed there it would hold the pose series back (later messages look older) or jump it ahead.
   if (o_.time_base != "stamp" && std::llabs(ev.stamp_us - ev.t_us) > 2'000'000) {
@@ -208,15 +210,37 @@ const msgs::Event& SlamInputs::Retime(const msgs::Event& ev, msgs::Event* copy) 
     mbot::log::WarnOnce("slam:stamp:" + ev.channel,
                         "slam: " + ev.channel + ": a stamp " + std::to_string((ev.stamp_us - ev.t_us) * 1e-6) +
                             " s from its arrival: placed at its arrival (further ones are counted)");
-    return ev;
+    return &ev;
   }
   if (ev.kind != EventKind::kLidar && ev.kind != EventKind::kOdometry && ev.kind != EventKind::kEncoders &&
       ev.kind != EventKind::kGroundTruth && ev.kind != EventKind::kReferencePose) {
-    return ev;
+    return &ev;
+  }
+  // A stamp well ahead of its channel's usual lag behind the arrival (the median of the last 15) is
+  // corrupt too, within the 2 s: placed there it would hold the series back until real stamps pass
+  // it, and the motion across that hole would look like a jump (a restart, confirmed by the next
+  // message). A message that arrived late is not judged: it is older, and placed where it belongs.
+  if (o_.time_base != "stamp") {
+    constexpr int64_t kAheadUs = 250'000;
+    std::deque<int64_t>& lags = lags_[ev.channel];
+    const int64_t lag = ev.t_us - ev.stamp_us;
+    if (lags.size() >= 5) {
+      std::vector<int64_t> v(lags.begin(), lags.end());
+      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+      if (lag < v[v.size() / 2] - kAheadUs) {
+        ++stamps_ahead_;
+        mbot::log::WarnOnce("slam:ahead:" + ev.channel,
+                            "slam: " + ev.channel + ": a stamp " + std::to_string((v[v.size() / 2] - lag) * 1e-6) +
+                                " s ahead of the channel's usual lag (corrupt): dropped (further ones are counted)");
+        return nullptr;
+      }
+    }
+    lags.push_back(lag);
+    if (lags.size() > 15) lags.pop_front();
   }
   *copy = ev;
   copy->t_us = ev.stamp_us;
-  return *copy;
+  return copy;
 }
 
 // `<lidar>.odom`: the odometry fields of the chosen (or, before the first scan, any) lidar's lines.
@@ -252,9 +276,15 @@ void SlamInputs::AddOdometry(int64_t t_us, const Pose2D& raw) {
   if (continuity_.restarts() > restarts) {
     restart_times_.push_back(continuity_.last_restart_us());
     if (restart_times_.size() > 64) restart_times_.pop_front();
-    mbot::log::Warn("slam: odometry jumped by more than a robot can move at " +
-                    std::to_string((t_us - first_t_us_) * 1e-6) +
-                    " s (a robot restart?): continuing from the pose before the jump");
+    const motion::OdometryContinuity::Restart& j = continuity_.last_restart();
+    auto pose = [&](const Pose2D& p, int64_t t) {
+      return "(" + Significant(p.x, 4) + ", " + Significant(p.y, 4) + ", " + Significant(p.theta, 3) + " rad at " +
+             Significant((t - first_t_us_) * 1e-6, 6) + " s)";
+    };
+    mbot::log::Warn(
+        "slam: odometry jumped by more than a robot can move at " + std::to_string((t_us - first_t_us_) * 1e-6) +
+        " s (a robot restart?): continuing from the pose before the jump; raw " + pose(j.before, j.before_us) +
+        " then " + pose(j.jumped, j.jumped_us) + ", confirmed by " + pose(j.confirmed, j.confirmed_us));
   }
   const Pose2D out = perturbation_.Apply(t_us, first_t_us_, continuous);
   odometry_.push_back({t_us, out});
@@ -325,7 +355,15 @@ void SlamSession::Finish(std::vector<msgs::Event>* out) {
   // Graph SLAM's poses are final only once the last loops are closed and the graph is solved.
   slam_.Finish();
   const std::vector<Pose2D> poses = slam_.Trajectory();
-  for (size_t i = 0; i < records_.size() && i < poses.size(); ++i) records_[i].slam = poses[i];
+  // Graph SLAM holds every record until now (released_ is 0), so record i is node i.
+  for (size_t i = released_; i - released_ < records_.size() && i < poses.size(); ++i)
+    records_[i - released_].slam = poses[i];
+  for (auto& item : scan_sample_.mutable_items())
+    if (item.index < poses.size()) item.value.pose = poses[item.index];
+  if (!records_.empty()) last_record_ = records_.back();
+  const int64_t max_gap = static_cast<int64_t>(o_.max_pose_gap_s * 1e6);
+  if (sink_)
+    while (!records_.empty()) ReleaseFront(max_gap);
 }
 
 void SlamSession::ProcessReadyScans(bool at_end, std::vector<msgs::Event>* out) {
@@ -370,7 +408,14 @@ void SlamSession::ProcessScan(const SlamInputs::Scan& p, int64_t t_end, std::vec
                         inputs_.PosesDoubtful(last_scan_end_us_, t_end, static_cast<int64_t>(gap_s * 1e6));
   last_scan_end_us_ = t_end;
   const SlamStep step = slam_.ProcessScan(rays, end_pose, mapping_only ? &end_pose : nullptr, doubtful);
-  if (scan_sample_.Wants(records_.size())) scan_sample_.Add(records_.size(), consistency_model_.Prepare(rays));
+  if (step.gated) {
+    mbot::log::WarnOnce("slam:gated",
+                        "slam: a scan fitting the map at under " + Significant(o_.slam.gate_fit_ratio, 3) +
+                            " of the recent scans' fit was not mapped (corrupt or misplaced; gate_fit_ratio); further "
+                            "ones are counted in metrics.json (scans_gated)");
+  }
+  const size_t index = scans_processed();
+  if (scan_sample_.Wants(index)) scan_sample_.Add(index, SampledScan{step.pose, consistency_model_.Prepare(rays)});
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - wall0).count();
 
   ScanRecord r;
@@ -381,32 +426,33 @@ void SlamSession::ProcessScan(const SlamInputs::Scan& p, int64_t t_end, std::vec
   r.status = step.status;
   r.update_ms = ms;
   r.latency_us = p.latency_us;
-  if (records_.size() % 64 == 0) rss_mb_ = ResidentMemoryMb();
+  if (index % 64 == 0) rss_mb_ = ResidentMemoryMb();
   r.rss_mb = rss_mb_;
   Pose2D odo;
   r.odometry = motion::InterpolateAt(inputs_.odometry(), t_end, max_gap, &odo) ? odo : end_pose;
   records_.push_back(r);
+  last_record_ = r;
   Publish(r, out);
-  if (o_.particles_every > 0 && slam_.HasParticles() && records_.size() % o_.particles_every == 1) {
+  if (o_.particles_every > 0 && slam_.HasParticles() && scans_processed() % o_.particles_every == 1) {
     for (const Particle& q : slam_.filter().particles()) particle_snapshots_.push_back(q.pose);
   }
   // Global-localization convergence and kidnapping: when lost was flagged, when the filter recovered.
   const std::string said =
-      events_.Add((r.t_us - inputs_.first_t_us()) * 1e-6, static_cast<int>(records_.size()) - 1, r.updated, r.status);
+      events_.Add((r.t_us - inputs_.first_t_us()) * 1e-6, static_cast<int>(index), r.updated, r.status);
   if (!said.empty()) mbot::log::Info("slam: " + said);
   // The map and pose, every checkpoint_every_s of the stream's time, for a run that has to resume.
   if (on_checkpoint_ && o_.checkpoint_every_s > 0 &&
       (last_checkpoint_us_ < 0 || r.t_us - last_checkpoint_us_ >= o_.checkpoint_every_s * 1e6)) {
     last_checkpoint_us_ = r.t_us;
     on_checkpoint_(SlamCheckpointState{r.slam, r.odometry, (r.t_us - inputs_.first_t_us()) * 1e-6,
-                                       static_cast<long long>(records_.size())},
+                                       static_cast<long long>(scans_processed())},
                    slam_.map());
   }
   PairRecordsAndTrim(t_end - duration, max_gap);
 }
 
 void SlamSession::PairRecordsAndTrim(int64_t scan_start_us, int64_t max_gap_us) {
-  std::vector<ScanRecord>* records = &records_;
+  std::deque<ScanRecord>* records = &records_;
   auto pair = [&](const std::vector<TimedPose>& series, size_t* next, std::optional<Pose2D> ScanRecord::*field) {
     while (*next < records->size() && !series.empty() && series.back().t_us >= (*records)[*next].t_us) {
       Pose2D p;
@@ -422,6 +468,26 @@ void SlamSession::PairRecordsAndTrim(int64_t scan_start_us, int64_t max_gap_us) 
   const int64_t waiting = std::min(pair(inputs_.ground_truth(), &paired_truth_, &ScanRecord::truth),
                                    pair(inputs_.reference(), &paired_reference_, &ScanRecord::reference));
   inputs_.TrimBefore(std::min(waiting, scan_start_us) - 2 * max_gap_us);
+  // Graph SLAM's poses change until Finish: its records are held.
+  if (!sink_ || o_.slam.mode == SlamMode::kGraphSlam) return;
+  // A record goes once both series have passed it, or once it is so old that a pose for it
+  // arriving now would be far later than any stream delivers (a series that stopped, or never ran).
+  const int64_t give_up_us = scan_start_us - (std::min<int64_t>(4 * max_gap_us, 60'000'000) + 1'000'000);
+  while (!records_.empty() && ((paired_truth_ > 0 && paired_reference_ > 0) || records_.front().t_us < give_up_us))
+    ReleaseFront(max_gap_us);
+}
+
+void SlamSession::ReleaseFront(int64_t max_gap_us) {
+  ScanRecord& r = records_.front();
+  // The last chance to pair it (at Finish, or a series that never passed it).
+  Pose2D p;
+  if (!r.truth && motion::InterpolateAt(inputs_.ground_truth(), r.t_us, max_gap_us, &p)) r.truth = p;
+  if (!r.reference && motion::InterpolateAt(inputs_.reference(), r.t_us, max_gap_us, &p)) r.reference = p;
+  sink_(r);
+  records_.pop_front();
+  ++released_;
+  if (paired_truth_ > 0) --paired_truth_;
+  if (paired_reference_ > 0) --paired_reference_;
 }
 
 bool SlamSession::Initialize(int64_t t_us, const Pose2D& odometry, const std::vector<ScanRay>& rays) {
@@ -485,13 +551,13 @@ void SlamSession::Publish(const ScanRecord& r, std::vector<msgs::Event>* out) {
         msgs::Event{r.t_us, r.t_us, msgs::topics::kSlamStatus, EventKind::kSlamStatus,
                     SlamStatus{state, o_.slam.mode, r.status.spread_m, slam_.mapping_on(), slam_.localization_on()}});
   }
-  if (o_.publish_particles_every > 0 && slam_.HasParticles() && records_.size() % o_.publish_particles_every == 0) {
+  const size_t scans = scans_processed();
+  if (o_.publish_particles_every > 0 && slam_.HasParticles() && scans % o_.publish_particles_every == 0) {
     msgs::Particles p;
     for (const Particle& q : slam_.filter().particles()) p.poses.push_back(q.pose), p.weights.push_back(q.weight);
     out->push_back(msgs::Event{r.t_us, r.t_us, msgs::topics::kSlamParticles, EventKind::kParticles, std::move(p)});
   }
-  if (o_.publish_map_every > 0 &&
-      (records_.size() == 1 || map_due_ || (builds_map && records_.size() % o_.publish_map_every == 0))) {
+  if (o_.publish_map_every > 0 && (scans == 1 || map_due_ || (builds_map && scans % o_.publish_map_every == 0))) {
     map_due_ = false;
     out->push_back(msgs::Event{r.t_us, r.t_us, msgs::topics::kSlamMap, EventKind::kMap,
                                std::make_shared<const OccupancyGrid>(slam_.map())});

@@ -83,12 +83,12 @@ MissionReport Mission::Report() const {
   return r;
 }
 
-std::vector<MissionOutput> Mission::OnOdometry(int64_t t_us, const Pose2D& raw_odometry) {
+std::vector<MissionOutput> Mission::OnOdometry(int64_t t_us, const Pose2D& raw_odometry, int64_t stamp_us) {
   std::vector<MissionOutput> out;
   out_ = &out;
   t_us_ = t_us;
   if (!odometry_.empty() && t_us < odometry_.back().t_us) return out;  // late: the series stays in order
-  odometry_.push_back({t_us, continuity_.Update(t_us, raw_odometry)});
+  odometry_.push_back({t_us, continuity_.Update(t_us, raw_odometry, stamp_us)});
   if (odometry_.front().t_us < t_us - 10'000'000) {  // trim to 5 s now and then, not every message
     odometry_.erase(odometry_.begin(), std::lower_bound(odometry_.begin(), odometry_.end(), t_us - 5'000'000,
                                                         [](const TimedPose& p, int64_t t) { return p.t_us < t; }));

@@ -367,6 +367,7 @@ struct SimRobot::Impl {
   Pose2D pose;
   double cmd_v = 0.0, cmd_w = 0.0;
   int64_t last_command_us = 0;
+  int commands_refused = 0;
   double duty_l = 0.0, duty_r = 0.0;     // what the firmware sent last
   double w_l = 0.0, w_r = 0.0;           // wheel rotational speeds [rad/s]
   double angle_l = 0.0, angle_r = 0.0;   // cumulative wheel rotation [rad]
@@ -393,11 +394,20 @@ SimRobot::SimRobot(World& world, const SimRobotOptions& options, const motion::P
 
 SimRobot::~SimRobot() = default;
 
-void SimRobot::Command(double v_m_s, double w_rad_s) {
-  impl_->cmd_v = std::isfinite(v_m_s) ? v_m_s : 0.0;
-  impl_->cmd_w = std::isfinite(w_rad_s) ? w_rad_s : 0.0;
+bool SimRobot::Command(double v_m_s, double w_rad_s) {
+  const SimRobotOptions& o = impl_->o;
+  // NaN fails both comparisons, so it is refused too.
+  if (!(std::abs(v_m_s) <= o.max_command_v_m_s && std::abs(w_rad_s) <= o.max_command_w_rad_s)) {
+    ++impl_->commands_refused;
+    return false;
+  }
+  impl_->cmd_v = v_m_s;
+  impl_->cmd_w = w_rad_s;
   impl_->last_command_us = impl_->now;
+  return true;
 }
+
+int SimRobot::commands_refused() const { return impl_->commands_refused; }
 
 bool SimRobot::CommandFork(double height_m) {
   if (!impl_->fork) return false;

@@ -112,12 +112,14 @@ std::vector<std::pair<std::string, std::string>> SimSource::Details() const {
   std::ostringstream start, duration;
   start << start_.x << ", " << start_.y << ", " << start_.theta * 180.0 / M_PI << " deg";
   duration << duration_us_ * 1e-6 << " s";
-  std::vector<std::pair<std::string, std::string>> d = {{"world", world_.name().empty() ? path_ : world_.name()},
-                                                        {"world file", path_},
-                                                        {"start", start.str()},
-                                                        {"seed", std::to_string(seed_)},
-                                                        {"duration", duration.str()},
-                                                        {"collisions", std::to_string(robot_->collisions())}};
+  std::vector<std::pair<std::string, std::string>> d = {
+      {"world", world_.name().empty() ? path_ : world_.name()},
+      {"world file", path_},
+      {"start", start.str()},
+      {"seed", std::to_string(seed_)},
+      {"duration", duration.str()},
+      {"collisions", std::to_string(robot_->collisions())},
+      {"velocity commands refused", std::to_string(robot_->commands_refused())}};
   if (robot_->forklift()) {
     d.push_back({"crates", std::to_string(world_.crates().size())});
     d.push_back({"forklift commands clamped", std::to_string(robot_->forklift_commands_clamped())});
@@ -140,7 +142,14 @@ void SimSource::Send(const Event& event) {
   }
   if (event.kind != EventKind::kMotorCommand) return;
   const auto* cmd = std::get_if<MotorCommand>(&event.payload);
-  if (cmd && cmd->kind == MotorCommand::Kind::kVelocity) robot_->Command(cmd->velocity.v_m_s, cmd->velocity.w_rad_s);
+  if (!cmd || cmd->kind != MotorCommand::Kind::kVelocity) return;
+  if (!robot_->Command(cmd->velocity.v_m_s, cmd->velocity.w_rad_s)) {
+    mbot::log::WarnOnce("sim:command_refused", "sim: velocity command (" + Significant(cmd->velocity.v_m_s, 4) +
+                                                   " m/s, " + Significant(cmd->velocity.w_rad_s, 4) + " rad/s) on " +
+                                                   event.channel +
+                                                   " refused: beyond the firmware's limits (max_command_v_m_s, "
+                                                   "max_command_w_rad_s); further ones are counted");
+  }
 }
 
 void RegisterSimSource() {

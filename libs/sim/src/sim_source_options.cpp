@@ -12,6 +12,67 @@
 
 namespace mbot::sim {
 
+void ParseSimRobotModel(config::Section& s, SimRobotOptions* robot) {
+  const auto doc = [](const std::string& text) { return std::string("simulator: ") + text; };
+  SimRobotOptions& r = *robot;
+  r.physics_dt_s = s.GetDouble("physics_dt_s", r.physics_dt_s, doc("integration step of the motion [s]"), 1e-4, 0.02);
+  r.footprint_radius_m =
+      s.GetDouble("footprint_radius_m", r.footprint_radius_m,
+                  doc("radius of the robot's disc footprint; touching a wall with it stops the robot [m]"), 0.01, 1.0);
+  r.left_motor_gain = s.GetDouble(
+      "left_motor_gain", r.left_motor_gain,
+      doc("true left wheel speed / the speed the motor model gives its duty (per-wheel difference)"), 0.5, 1.5);
+  r.right_motor_gain = s.GetDouble("right_motor_gain", r.right_motor_gain,
+                                   doc("true right wheel speed / the speed the motor model gives its duty"), 0.5, 1.5);
+  r.motor_time_constant_s =
+      s.GetDouble("motor_time_constant_s", r.motor_time_constant_s,
+                  doc("first-order lag of a wheel's speed behind its duty's steady state [s]"), 0.0, 1.0);
+  r.slip_stddev =
+      s.GetDouble("slip_stddev", r.slip_stddev,
+                  doc("relative error of each wheel's ground speed against its rotation (std. dev.)"), 0.0, 0.5);
+  r.slip_interval_s =
+      s.GetDouble("slip_interval_s", r.slip_interval_s, doc("how often each wheel's slip is redrawn [s]"), 0.001, 10.0);
+  const double firmware_rate_hz =
+      s.GetDouble("firmware_rate_hz", 1.0 / r.controller.dt_s,
+                  doc("rate of the firmware's wheel-speed controller and its encoder, wheel-speed, odometry and PWM "
+                      "messages [Hz]"),
+                  5.0, 1000.0);
+  r.controller.dt_s = 1.0 / firmware_rate_hz;
+  r.command_timeout_s = s.GetDouble("command_timeout_s", r.command_timeout_s,
+                                    doc("the firmware stops the motors after this long without a velocity command "
+                                        "(0: never) [s]"),
+                                    0.0, 1e4);
+  r.max_command_v_m_s = s.GetDouble("max_command_v_m_s", r.max_command_v_m_s,
+                                    doc("the firmware refuses a velocity command faster than this (mbot_firmware's "
+                                        "MAX_FWD_VEL); the last good one holds [m/s]"),
+                                    0.0, 100.0);
+  r.max_command_w_rad_s = s.GetDouble("max_command_w_rad_s", r.max_command_w_rad_s,
+                                      doc("... or turning faster than this (MAX_TURN_VEL) [rad/s]"), 0.0, 1000.0);
+  r.ground_truth_rate_hz = s.GetDouble("ground_truth_rate_hz", r.ground_truth_rate_hz,
+                                       doc("rate of the TRUE_POSE messages [Hz]"), 1.0, 1000.0);
+
+  SimImuOptions& imu = r.imu;
+  imu.rate_hz = s.GetDouble("imu_rate_hz", imu.rate_hz, doc("rate of the IMU messages [Hz]"), 1.0, 1000.0);
+  imu.gyro_noise_rad_s = s.GetDouble("gyro_noise_rad_s", imu.gyro_noise_rad_s,
+                                     doc("white noise of each gyro sample, standard deviation [rad/s]"), 0.0, 1.0);
+  imu.gyro_bias_initial_rad_s = s.GetDouble("gyro_bias_initial_rad_s", imu.gyro_bias_initial_rad_s,
+                                            doc("standard deviation of the gyro bias at start [rad/s]"), 0.0, 1.0);
+  imu.gyro_bias_walk_rad_s_sqrt_s = s.GetDouble("gyro_bias_walk_rad_s_sqrt_s", imu.gyro_bias_walk_rad_s_sqrt_s,
+                                                doc("random walk of the gyro bias [rad/s/sqrt(s)]"), 0.0, 1.0);
+
+  SimLidarOptions& l = r.lidar;
+  l.rate_hz = s.GetDouble("lidar_rate_hz", l.rate_hz, doc("lidar revolutions per second [Hz]"), 0.5, 100.0);
+  l.beams = static_cast<int>(s.GetInt("lidar_beams", l.beams, doc("lidar beams per revolution"), 8, 100000));
+  l.max_range_m = s.GetDouble("lidar_max_range_m", l.max_range_m,
+                              doc("lidar range limit; farther walls give no return [m]"), 0.5, 100.0);
+  l.min_range_m =
+      s.GetDouble("lidar_min_range_m", l.min_range_m, doc("closer lidar returns are dropped [m]"), 0.0, 10.0);
+  if (l.min_range_m >= l.max_range_m) s.Fail("lidar_min_range_m", "must be below lidar_max_range_m");
+  l.range_noise_m =
+      s.GetDouble("lidar_range_noise_m", l.range_noise_m, doc("lidar range noise, standard deviation [m]"), 0.0, 1.0);
+  l.dropout = s.GetDouble("lidar_dropout", l.dropout, doc("probability that a lidar beam gives no return"), 0.0, 1.0);
+}
+
 SimSourceOptions ParseSimSourceOptions(config::Section& s) {
   // Every key is documented as the simulator's: they exist only when the source is the simulator.
   const auto doc = [](const std::string& text) { return std::string("simulator: ") + text; };
@@ -41,57 +102,7 @@ SimSourceOptions ParseSimSourceOptions(config::Section& s) {
   if (o.realtime_factor > 0 && o.realtime_factor < 0.01) s.Fail("realtime_factor", "must be 0 (off) or at least 0.01");
 
   SimRobotOptions& r = o.robot;
-  r.physics_dt_s = s.GetDouble("physics_dt_s", r.physics_dt_s, doc("integration step of the motion [s]"), 1e-4, 0.02);
-  r.footprint_radius_m =
-      s.GetDouble("footprint_radius_m", r.footprint_radius_m,
-                  doc("radius of the robot's disc footprint; touching a wall with it stops the robot [m]"), 0.01, 1.0);
-  r.left_motor_gain = s.GetDouble(
-      "left_motor_gain", r.left_motor_gain,
-      doc("true left wheel speed / the speed the motor model gives its duty (per-wheel difference)"), 0.5, 1.5);
-  r.right_motor_gain = s.GetDouble("right_motor_gain", r.right_motor_gain,
-                                   doc("true right wheel speed / the speed the motor model gives its duty"), 0.5, 1.5);
-  r.motor_time_constant_s =
-      s.GetDouble("motor_time_constant_s", r.motor_time_constant_s,
-                  doc("first-order lag of a wheel's speed behind its duty's steady state [s]"), 0.0, 1.0);
-  r.slip_stddev =
-      s.GetDouble("slip_stddev", r.slip_stddev,
-                  doc("relative error of each wheel's ground speed against its rotation (std. dev.)"), 0.0, 0.5);
-  r.slip_interval_s =
-      s.GetDouble("slip_interval_s", r.slip_interval_s, doc("how often each wheel's slip is redrawn [s]"), 0.001, 10.0);
-  const double firmware_rate_hz =
-      s.GetDouble("firmware_rate_hz", 1.0 / r.controller.dt_s,
-                  doc("rate of the firmware's wheel-speed controller and its encoder, wheel-speed, odometry and PWM "
-                      "messages [Hz]"),
-                  5.0, 1000.0);
-  r.controller.dt_s = 1.0 / firmware_rate_hz;
-  r.command_timeout_s = s.GetDouble("command_timeout_s", r.command_timeout_s,
-                                    doc("the firmware stops the motors after this long without a velocity command "
-                                        "(0: never) [s]"),
-                                    0.0, 1e4);
-  r.ground_truth_rate_hz = s.GetDouble("ground_truth_rate_hz", r.ground_truth_rate_hz,
-                                       doc("rate of the TRUE_POSE messages [Hz]"), 1.0, 1000.0);
-
-  SimImuOptions& imu = r.imu;
-  imu.rate_hz = s.GetDouble("imu_rate_hz", imu.rate_hz, doc("rate of the IMU messages [Hz]"), 1.0, 1000.0);
-  imu.gyro_noise_rad_s = s.GetDouble("gyro_noise_rad_s", imu.gyro_noise_rad_s,
-                                     doc("white noise of each gyro sample, standard deviation [rad/s]"), 0.0, 1.0);
-  imu.gyro_bias_initial_rad_s = s.GetDouble("gyro_bias_initial_rad_s", imu.gyro_bias_initial_rad_s,
-                                            doc("standard deviation of the gyro bias at start [rad/s]"), 0.0, 1.0);
-  imu.gyro_bias_walk_rad_s_sqrt_s = s.GetDouble("gyro_bias_walk_rad_s_sqrt_s", imu.gyro_bias_walk_rad_s_sqrt_s,
-                                                doc("random walk of the gyro bias [rad/s/sqrt(s)]"), 0.0, 1.0);
-
-  SimLidarOptions& l = r.lidar;
-  l.rate_hz = s.GetDouble("lidar_rate_hz", l.rate_hz, doc("lidar revolutions per second [Hz]"), 0.5, 100.0);
-  l.beams = static_cast<int>(s.GetInt("lidar_beams", l.beams, doc("lidar beams per revolution"), 8, 100000));
-  l.max_range_m = s.GetDouble("lidar_max_range_m", l.max_range_m,
-                              doc("lidar range limit; farther walls give no return [m]"), 0.5, 100.0);
-  l.min_range_m =
-      s.GetDouble("lidar_min_range_m", l.min_range_m, doc("closer lidar returns are dropped [m]"), 0.0, 10.0);
-  if (l.min_range_m >= l.max_range_m) s.Fail("lidar_min_range_m", "must be below lidar_max_range_m");
-  l.range_noise_m =
-      s.GetDouble("lidar_range_noise_m", l.range_noise_m, doc("lidar range noise, standard deviation [m]"), 0.0, 1.0);
-  l.dropout = s.GetDouble("lidar_dropout", l.dropout, doc("probability that a lidar beam gives no return"), 0.0, 1.0);
-
+  ParseSimRobotModel(s, &r);
   ForkliftOptions& f = r.forklift;
   f.enabled = s.GetBool("forklift", f.enabled,
                         doc("the robot has a forklift (Heavy Lift): tines at its front that lift crates, commanded "

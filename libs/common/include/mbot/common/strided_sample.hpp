@@ -31,6 +31,7 @@ class StridedSample {
   void Add(size_t index, T value) { items_.push_back({index, std::move(value)}); }
 
   const std::vector<Item>& items() const { return items_; }
+  std::vector<Item>& mutable_items() { return items_; }  // the values may change, not the indices
 
  private:
   size_t capacity_;

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <string>
 #include <vector>
@@ -35,12 +36,19 @@ struct SlamOptions {
   SensorModelOptions sensor;
   ParticleFilterOptions filter;
   GraphSlamOptions graph;  // graph SLAM only
+  // Full SLAM: a scan whose returns fit the map at its pose at under this share of the recent
+  // mapped scans' median fit (a corrupt or misplaced scan: a bad stamp, a bad odometry step) is not
+  // mapped; 0: off. After gate_max_scans such scans in a row the next is mapped whatever it fits
+  // (the world changed, or the pose was wrong and was corrected: the map must follow).
+  double gate_fit_ratio = 0.5;
+  int gate_max_scans = 3;
 };
 
 struct SlamStep {
   motion::Pose2D pose;
   bool filter_updated = false;  // the particle filter ran on this scan
   FilterStatus status;          // the filter's state after this scan (when it has one)
+  bool gated = false;           // full SLAM: the scan's fit to the map collapsed, so it was not mapped
 };
 
 // What happened to the filter over a run, scan by scan: when global localization converged, when
@@ -119,9 +127,11 @@ class Slam {
   const ParticleFilter& filter() const { return filter_; }
   const SlamOptions& options() const { return options_; }
   int64_t filter_updates() const { return filter_.updates(); }
+  int64_t scans_gated() const { return scans_gated_; }
 
  private:
   bool UsesFilter() const { return options_.mode != SlamMode::kMappingOnly; }
+  bool Gate(const std::vector<ScanRay>& rays, const motion::Pose2D& pose);
 
   SlamOptions options_;
   LogOddsMapper mapper_;
@@ -133,8 +143,11 @@ class Slam {
   bool initialized_ = false;
   bool sensor_stale_ = true;
   bool mapping_on_ = true, localization_on_ = true;
-  motion::Pose2D last_odometry_;  // odometry at the last filter update
-  motion::Pose2D last_estimate_;  // the estimate then
+  motion::Pose2D last_odometry_;    // odometry at the last filter update
+  motion::Pose2D last_estimate_;    // the estimate then
+  std::deque<double> recent_fits_;  // the gate's history: the fits of the last scans taken
+  int gated_in_row_ = 0;
+  int64_t scans_gated_ = 0;
 };
 
 }  // namespace mbot::mapping

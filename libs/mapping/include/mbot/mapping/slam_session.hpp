@@ -102,6 +102,7 @@ class SlamInputs {
   const std::map<std::string, int64_t>& odometry_channels_seen() const { return odometry_seen_; }
   int64_t kidnapped_at_us() const { return perturbation_.kidnapped_at_us(); }
   int odometry_restarts() const { return continuity_.restarts(); }
+  const motion::OdometryContinuity& continuity() const { return continuity_; }
   // Whether the poses between `from_us` and `to_us` (with the readings around them) leave a gap
   // longer than `max_gap_us`, or the odometry restarted (a zeroed jump) in (from_us, to_us].
   bool PosesDoubtful(int64_t from_us, int64_t to_us, int64_t max_gap_us) const;
@@ -112,7 +113,8 @@ class SlamInputs {
   void TrimBefore(int64_t t_us);
 
  private:
-  const msgs::Event& Retime(const msgs::Event& ev, msgs::Event* copy);
+  // The event placed at its time, or nullptr for one whose stamp is corrupt (dropped).
+  const msgs::Event* Retime(const msgs::Event& ev, msgs::Event* copy);
   bool Accept(std::string* chosen, const std::string& wanted, const msgs::Event& ev);
   bool ScanLineOdometry(const std::string& channel) const;
   void AddOdometry(int64_t t_us, const motion::Pose2D& raw);
@@ -128,8 +130,10 @@ class SlamInputs {
   int64_t previous_scan_us_ = -1;
   int64_t scans_seen_ = 0;
   std::map<std::string, int64_t> odometry_seen_;
-  long long stamp_outliers_ = 0;       // stamps far from their arrival, placed at the arrival instead
-  std::deque<int64_t> restart_times_;  // the last restarts the continuity check zeroed, oldest first
+  long long stamp_outliers_ = 0;                     // stamps far from their arrival, placed at the arrival instead
+  long long stamps_ahead_ = 0;                       // stamps well ahead of their channel's usual lag: dropped
+  std::map<std::string, std::deque<int64_t>> lags_;  // per stamped channel: the last arrival − stamp
+  std::deque<int64_t> restart_times_;                // the last restarts the continuity check zeroed, oldest first
   int64_t first_t_us_ = -1, last_t_us_ = -1;
 };
 
@@ -148,8 +152,12 @@ struct ScanRecord {
   std::optional<motion::Pose2D> truth, reference;
 };
 
-// The scans kept for the map-consistency metric: each one's record index and points.
-using ScanSample = StridedSample<ScanPoints>;
+// The scans kept for the map-consistency metric: each one's record index, points and pose.
+struct SampledScan {
+  motion::Pose2D pose;
+  ScanPoints points;
+};
+using ScanSample = StridedSample<SampledScan>;
 
 // What a checkpoint holds besides the map (Slam::map()).
 struct SlamCheckpointState {
@@ -179,10 +187,18 @@ class SlamSession {
     on_checkpoint_ = std::move(write);
   }
 
+  // Streams the records: each goes to `sink` once its pose is final and its truth and reference
+  // are paired (full SLAM, localization: a few scans behind; graph SLAM: all at Finish, with the
+  // optimised poses), and is then dropped, so a run of any length holds a bounded number. Without
+  // a sink every record is kept (records()).
+  void StreamRecords(std::function<void(const ScanRecord&)> sink) { sink_ = std::move(sink); }
+
   const SlamSessionOptions& options() const { return o_; }
   const Slam& slam() const { return slam_; }
   const SlamInputs& inputs() const { return inputs_; }
-  const std::vector<ScanRecord>& records() const { return records_; }
+  const std::deque<ScanRecord>& records() const { return records_; }  // those not streamed yet
+  size_t scans_processed() const { return released_ + records_.size(); }
+  const std::optional<ScanRecord>& last_record() const { return last_record_; }
   const SlamEventTracker& events() const { return events_; }
   const std::vector<ScanSample::Item>& scan_points() const { return scan_sample_.items(); }
   const std::vector<motion::Pose2D>& particle_snapshots() const { return particle_snapshots_; }
@@ -195,6 +211,7 @@ class SlamSession {
   bool Initialize(int64_t t_us, const motion::Pose2D& odometry, const std::vector<ScanRay>& rays);
   void Publish(const ScanRecord& r, std::vector<msgs::Event>* out);
   void PairRecordsAndTrim(int64_t scan_start_us, int64_t max_gap_us);
+  void ReleaseFront(int64_t max_gap_us);
 
   const SlamSessionOptions& o_;
   Slam slam_;
@@ -203,8 +220,11 @@ class SlamSession {
   SlamEventTracker events_;
   SensorModel consistency_model_;
   ScanSample scan_sample_{2048};  // the map-consistency metric's scans: bounded for any run length
-  std::vector<ScanRecord> records_;
+  std::deque<ScanRecord> records_;
   size_t paired_truth_ = 0, paired_reference_ = 0;  // records before these have their truth / reference
+  size_t released_ = 0;                             // records handed to the sink and dropped
+  std::function<void(const ScanRecord&)> sink_;
+  std::optional<ScanRecord> last_record_;
   std::vector<motion::Pose2D> particle_snapshots_;
   std::optional<SlamState> published_state_;
   int skipped_scans_ = 0;

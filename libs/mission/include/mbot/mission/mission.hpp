@@ -167,7 +167,7 @@ class Mission {
   void OnForklift(const ForkliftState& state) { forklift_ = state; }
   // The control step, on every odometry message (the firmware's 50 Hz): what to publish and
   // command now. Every step ends with exactly one velocity command.
-  std::vector<MissionOutput> OnOdometry(int64_t t_us, const motion::Pose2D& odometry);
+  std::vector<MissionOutput> OnOdometry(int64_t t_us, const motion::Pose2D& odometry, int64_t stamp_us = 0);
 
   const MissionStatus& status() const { return status_; }
   const MissionOptions& options() const { return o_; }

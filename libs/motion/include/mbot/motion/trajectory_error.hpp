@@ -5,6 +5,7 @@
 // poses coincide.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "mbot/motion/pose2d.hpp"
@@ -29,6 +30,37 @@ Pose2D BestFitSE2(const std::vector<Pose2D>& estimate, const std::vector<Pose2D>
 
 // `estimate` and `truth` are paired by index; both must have the same size (≥ 1).
 AteResult ComputeAte(const std::vector<Pose2D>& estimate, const std::vector<Pose2D>& truth, AteAlignment alignment);
+
+// The same scores over pairs that need not fit in memory (a trajectory of hours, read back from
+// disk): every pair goes to AddForAlignment, then every pair again, in the same order, to
+// AddError; Result() then equals ComputeAte on the whole series. kNone needs no first pass.
+class AteAccumulator {
+ public:
+  explicit AteAccumulator(AteAlignment alignment) : alignment_(alignment) {}
+  void AddForAlignment(const Pose2D& estimate, const Pose2D& truth);
+  void AddError(const Pose2D& estimate, const Pose2D& truth);
+  // The transform applied to the estimate (fixed by the first pass); throws when no pair was added.
+  Pose2D Alignment() const;
+  int samples() const { return errors_; }
+  AteResult Result() const;  // throws std::invalid_argument when no pair was added
+
+ private:
+  struct Sums {
+    double sum = 0, sq = 0, max = 0;
+    void Add(double v);
+    ErrorStats Stats(int n) const;
+  };
+  AteAlignment alignment_;
+  // First pass: the sums BestFitSE2 needs (centred cross terms from raw moments) and the first pair.
+  long long n_ = 0;
+  double ex_ = 0, ey_ = 0, tx_ = 0, ty_ = 0, dot_ = 0, cross_ = 0, tt_ = 0, sin_ = 0, cos_ = 0;
+  Pose2D first_est_, first_truth_;
+  mutable std::optional<Pose2D> alignment_pose_;
+  // Second pass.
+  int errors_ = 0;
+  Sums x_, y_, theta_, xy_;
+  Pose2D final_error_;
+};
 
 // An estimate scored against the truth under each convention at once.
 struct TrajectoryErrors {

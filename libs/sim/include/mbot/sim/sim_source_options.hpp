@@ -29,6 +29,10 @@ struct SimSourceOptions {
   SimRobotOptions robot;
 };
 
+// The simulated robot's model — motion, motors and firmware, IMU, lidar — from `section`: the keys
+// ParseSimSourceOptions reads for it (sim_fidelity reads the same ones for the robot it measures).
+void ParseSimRobotModel(config::Section& section, SimRobotOptions* robot);
+
 // Reads the simulator's keys of [source]. Throws config::ConfigError naming the key.
 SimSourceOptions ParseSimSourceOptions(config::Section& section);
 
