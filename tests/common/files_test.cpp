@@ -1,5 +1,7 @@
 #include "mbot/common/files.hpp"
 
+#include "mbot/common/atomic_file.hpp"
+
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -55,6 +57,35 @@ TEST(RequireReadableFile, AnUnreadableFileIsPermissionDenied) {
   ASSERT_TRUE(WIFEXITED(status));
   ASSERT_NE(WEXITSTATUS(status), 3) << "root could not drop to user nobody";
   EXPECT_EQ(WEXITSTATUS(status), 0) << "expected '" << file << ": permission denied'";
+}
+
+// A file written a piece at a time appears whole at Commit, or not at all; what a killed writer left
+// (its process gone) is cleaned up by the next one, what a live one is writing is not.
+TEST(AtomicFileWriter, CommitsWholeOrLeavesNothingAndStaleTempFilesGo) {
+  const std::string path = Scratch("pieces.tum");
+  std::filesystem::remove(path);
+  {
+    AtomicFileWriter w(path);
+    w.stream() << "a\n";
+    EXPECT_FALSE(std::filesystem::exists(path));
+  }  // not committed
+  EXPECT_FALSE(std::filesystem::exists(path));
+  {
+    AtomicFileWriter w(path);
+    w.stream() << "a\nb\n";
+    w.Commit();
+  }
+  std::ifstream in(path);
+  std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(all, "a\nb\n");
+  const std::string dir = std::filesystem::path(path).parent_path().string();
+  const std::string dead = dir + "/.tmp.999999999.pieces.tum", mine = TempPathFor(path);
+  std::ofstream(dead) << "left by a killed run";
+  std::ofstream(mine) << "being written";
+  EXPECT_EQ(RemoveStaleTempFiles(path), 1);
+  EXPECT_FALSE(std::filesystem::exists(dead));
+  EXPECT_TRUE(std::filesystem::exists(mine));
+  std::filesystem::remove(mine);
 }
 
 }  // namespace

@@ -2,8 +2,9 @@
 // simulated robot publishes it (pose2D_t, 50 Hz, turning in place at 2.5 rad/s and driving at
 // 0.3 m/s), through the fault relay's injector (5 % drops, 5 % duplicates, 5 % reordered, 2 % with
 // 1-4 corrupted bytes, 20 ms + 0-20 ms), decoded and checked as the live source does, into SLAM's
-// inputs. The robot never restarts, so the continuity check must never take a jump for a restart:
-// each one the live `mixed` runs took sent SLAM and the mission off their map.
+// inputs at their arrival times (SLAM's default time base) and to the mission's own continuity
+// check. The robot never restarts, so neither may take a jump for a restart: each one the live
+// `mixed` runs took sent SLAM and the mission off their map.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -48,13 +49,14 @@ TEST(MixedFaults, CorruptDuplicatedAndReorderedOdometryNeverReadsAsARestart) {
     int64_t mission_last_us = -1;
     const int64_t t0 = 1'700'000'000'000'000;  // the wall clock both ends share
     auto deliver = [&](double now) {
+      int64_t apart = 0;  // messages due at once reach the receive thread microseconds apart
       for (const FaultInjector::Message& m : relay.TakeDue(now)) {
         Event ev;
         std::string error;
         if (!lcm_adapter::Decode(m.channel, m.data.data(), m.data.size(), msgs::ChannelRoles{}, &ev, &error)) continue;
         if (!msgs::IsPlausibleTimeUs(ev.stamp_us)) continue;
         ev.channel = m.channel;
-        ev.t_us = t0 + static_cast<int64_t>(std::llround(m.due_s * 1e6));
+        ev.t_us = t0 + static_cast<int64_t>(std::llround(m.due_s * 1e6)) + apart++;
         taken += inputs.Add(ev);
         if (ev.t_us >= mission_last_us) {
           mission.Update(ev.t_us, std::get<motion::Pose2D>(ev.payload), ev.stamp_us);

@@ -101,6 +101,8 @@ TEST(RefereeSpeedRun, ScoresAPerfectLapAndEndsAfterTheMission) {
   r.Tick(14'000'000);
   r.OnTruePose(14'000'000, {start.x + 0.01, start.y, start.theta});
   r.OnMissionStatus(14'000'000, {mission::MissionState::kCompleted, "circuit driven"});
+  // An older status that a faulty link delivered late does not undo the completion.
+  r.OnMissionStatus(14'100'000, {mission::MissionState::kReturningHome, "returning home"});
   EXPECT_FALSE(r.StopReason(14'000'000));
   EXPECT_TRUE(r.StopReason(14'600'000));
   EXPECT_FALSE(r.StopReason(14'700'000));  // once

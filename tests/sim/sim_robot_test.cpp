@@ -82,25 +82,38 @@ TEST(SimRobot, DrivesStraightAtTheCommandedSpeed) {
   EXPECT_EQ(robot.collisions(), 0);
 }
 
-// The firmware's gate on a faulty bus: a command beyond its limits (a corrupt one: 1e5 m/s, NaN) is
-// refused, and the last good command holds.
-TEST(SimRobot, RefusesCommandsBeyondTheFirmwaresLimits) {
+// The firmware's gate on a faulty bus: a command beyond twice its limits (a corrupt one: 1e5 m/s) is
+// refused and the last good command holds; up to twice them it is clamped, as the firmware does;
+// a non-finite one stops the robot.
+TEST(SimRobot, RefusesCommandsFarBeyondTheFirmwaresLimits) {
   World world = Box(3.0);
   SimRobot robot(world, SimRobotOptions{}, {-1.5, 0, 0}, 1);
   std::vector<Event> out;
   EXPECT_TRUE(robot.Command(0.2, 0.0));
   robot.AdvanceTo(kSecond, &out);
   EXPECT_FALSE(robot.Command(1e5, 0.0));
-  EXPECT_FALSE(robot.Command(0.2, NAN));
-  EXPECT_FALSE(robot.Command(-0.81, 0.0));  // MAX_FWD_VEL 0.8 m/s
-  EXPECT_FALSE(robot.Command(0.2, 2.6));    // MAX_TURN_VEL 2.5 rad/s
-  EXPECT_TRUE(robot.Command(0.8, -2.5));    // at the limits
+  EXPECT_FALSE(robot.Command(-1.7, 0.0));  // MAX_FWD_VEL 0.8 m/s, twice it 1.6
+  EXPECT_FALSE(robot.Command(0.2, 5.1));   // MAX_TURN_VEL 2.5 rad/s
   EXPECT_TRUE(robot.Command(0.2, 0.0));
   robot.AdvanceTo(2 * kSecond, &out);
-  EXPECT_EQ(robot.commands_refused(), 4);
+  EXPECT_EQ(robot.commands_refused(), 3);
   // Driven at 0.2 m/s throughout: the refused commands changed nothing.
   EXPECT_GT(robot.distance_travelled_m(), 0.3);
   EXPECT_LT(robot.distance_travelled_m(), 0.42);
+  // 1.2 m/s is clamped to 0.8: over a second at most 0.8 m more.
+  const double before = robot.distance_travelled_m();
+  for (int k = 0; k < 10; ++k) {
+    EXPECT_TRUE(robot.Command(1.2, 0.0));
+    robot.AdvanceTo(robot.now_us() + kSecond / 10, &out);
+  }
+  EXPECT_LT(robot.distance_travelled_m() - before, 0.8 + 1e-6);
+  EXPECT_GT(robot.distance_travelled_m() - before, 0.4);
+  // NaN: the robot stops.
+  EXPECT_FALSE(robot.Command(NAN, 0.0));
+  robot.AdvanceTo(robot.now_us() + kSecond, &out);
+  const double stopped = robot.distance_travelled_m();
+  robot.AdvanceTo(robot.now_us() + kSecond / 2, &out);
+  EXPECT_NEAR(robot.distance_travelled_m(), stopped, 1e-3);
 }
 
 TEST(SimRobot, TurnsInPlace) {

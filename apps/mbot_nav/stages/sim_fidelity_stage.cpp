@@ -159,6 +159,10 @@ const RegisterStage kSimFidelityRegistered{
        sim::ParseSimRobotModel(s, &f.robot);
        f.lidar_min_range_m = f.robot.lidar.min_range_m;
        f.lidar_max_range_m = f.robot.lidar.max_range_m;
+       const config::PoseValue mount =
+           s.GetPose("lidar_mount", {}, "the lidar's pose on the logged robot: x [m], y [m], theta [deg]");
+       f.lidar_mount = {mount.x_m, mount.y_m, mount.theta_rad};
+       f.robot.lidar.mount = f.lidar_mount;
        f.gyro_scale = s.GetDouble("gyro_scale", f.gyro_scale,
                                   "multiplies the log's gyro yaw rate into rad/s (0.0174533 for deg/s)", -100.0, 100.0);
        f.max_pose_gap_s = s.GetDouble("max_pose_gap_s", f.max_pose_gap_s,

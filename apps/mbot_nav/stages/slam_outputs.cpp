@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <optional>
 #include <sstream>
 
@@ -29,6 +30,9 @@ SlamRecordWriter::SlamRecordWriter(const std::string& dir, const SlamStageOption
       dir_(dir + "/"),
       truth_name_(options.truth_is_reference ? "reference" : "ground truth"),
       spool_path_(TempPathFor(dir_ + "slam_records.spool")) {
+  // What a run killed in this folder left (a SIGKILL renames nothing): gone before this one starts.
+  for (const char* name : {"slam.tum", "odometry.tum", "ground_truth.tum", "slam_scans.csv"})
+    RemoveStaleTempFiles(dir_ + name);
   slam_tum_ = std::make_unique<AtomicFileWriter>(dir_ + "slam.tum");
   slam_tum_->stream() << TumHeader(std::string("SLAM (") + mapping::ToString(options.session.slam.mode) + ")");
   odometry_tum_ = std::make_unique<AtomicFileWriter>(dir_ + "odometry.tum");
@@ -38,15 +42,14 @@ SlamRecordWriter::SlamRecordWriter(const std::string& dir, const SlamStageOption
                           "lost,converged,update_ms,rss_mb\n";
   spool_.open(spool_path_, std::ios::binary | std::ios::trunc | std::ios::in | std::ios::out);
   if (!spool_) throw std::runtime_error(spool_path_ + ": cannot create the slam stage's record spool");
+  std::remove(spool_path_.c_str());  // the open stream keeps it; no name is left to clean up
 }
 
-SlamRecordWriter::~SlamRecordWriter() {
-  spool_.close();
-  std::remove(spool_path_.c_str());
-}
+SlamRecordWriter::~SlamRecordWriter() = default;
 
 void SlamRecordWriter::Add(const ScanRecord& r, int64_t first_t_us) {
   Spooled sp;
+  std::memset(static_cast<void*>(&sp), 0, sizeof sp);  // the padding too: the bytes go to disk
   sp.t_us = r.t_us;
   sp.tum_t_us = o_.tum_stamps ? r.stamp_us : r.t_us;
   sp.latency_us = r.latency_us;
@@ -92,11 +95,15 @@ void SlamRecordWriter::Commit() {
   if (truth_tum_) truth_tum_->Commit();
 }
 
-void SlamRecordWriter::ForEach(const std::function<void(const Spooled&)>& f) const {
-  std::ifstream in(spool_path_, std::ios::binary);
+void SlamRecordWriter::ForEach(const std::function<void(const Spooled&)>& f) {
+  spool_.flush();
+  spool_.clear();
+  spool_.seekg(0);
   Spooled sp;
   size_t n = 0;
-  while (n < records_ && in.read(reinterpret_cast<char*>(&sp), sizeof sp)) f(sp), ++n;
+  while (n < records_ && spool_.read(reinterpret_cast<char*>(&sp), sizeof sp)) f(sp), ++n;
+  spool_.clear();
+  spool_.seekp(0, std::ios::end);
   if (n != records_) {
     throw std::runtime_error(spool_path_ + ": read back " + std::to_string(n) + " of " + std::to_string(records_) +
                              " records");

@@ -24,7 +24,8 @@ namespace mbot::app {
 // so a run of any length keeps flat memory: slam.tum, odometry.tum, ground_truth.tum and
 // slam_scans.csv (each renamed into place at Commit, whole, or removed), and a spool beside them of
 // what the scores need — the poses paired with the truth, the timings — which WriteSlamOutputs
-// reads back from disk (the ATE in two passes, the relations, the medians, the map's paths).
+// reads back from disk at the end (the ATE in two passes; the relations, the medians and the map's
+// paths need the whole run then, about 100 bytes a scan, freed once written).
 class SlamRecordWriter {
  public:
   SlamRecordWriter(const std::string& dir, const SlamStageOptions& options);
@@ -45,7 +46,7 @@ class SlamRecordWriter {
     float update_ms = 0, ess = 0;
   };
   // Calls `f` on every spooled record, in order (readable after Commit, as often as needed).
-  void ForEach(const std::function<void(const Spooled&)>& f) const;
+  void ForEach(const std::function<void(const Spooled&)>& f);
   size_t records() const { return records_; }
   int unscored_late() const { return unscored_late_; }
   bool has_truth() const { return truth_tum_ != nullptr; }
@@ -54,7 +55,7 @@ class SlamRecordWriter {
   const SlamStageOptions& o_;
   std::string dir_, truth_name_, spool_path_;
   std::unique_ptr<AtomicFileWriter> slam_tum_, odometry_tum_, scans_csv_, truth_tum_;
-  std::ofstream spool_;
+  std::fstream spool_;  // unlinked once open: nothing is left behind, however the run ends
   size_t records_ = 0;
   int unscored_late_ = 0;
 };

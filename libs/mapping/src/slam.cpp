@@ -48,6 +48,7 @@ void Slam::SetMap(OccupancyGrid map) {
   mapper_.Reset(std::move(map));
   sensor_stale_ = true;
   filter_.SetFreeSpace(mapper_.map());
+  ResetGate();
 }
 
 void Slam::Initialize(const motion::Pose2D& pose, const motion::Pose2D& odometry, double sigma_xy_m,
@@ -103,13 +104,20 @@ SlamStep Slam::ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2
   out.status = filter_.status();
   out.pose = last_estimate_.Compose(last_odometry_.Inverse().Compose(odometry));
   if (options_.mode != SlamMode::kLocalization && mapping_on_) {
-    out.gated = options_.mode == SlamMode::kFullSlam && Gate(rays, out.pose);
+    // The gate's map is the sensor model's, rebuilt at filter updates: with localization off it
+    // may be far behind the map, so nothing is gated then.
+    out.gated = options_.mode == SlamMode::kFullSlam && localization_on_ && Gate(rays, out.pose);
     if (!out.gated) {
       mapper_.Insert(rays, out.pose);
       sensor_stale_ = true;
     }
   }
   return out;
+}
+
+void Slam::ResetGate() {
+  recent_fits_.clear();
+  gated_in_row_ = 0;
 }
 
 bool Slam::Gate(const std::vector<ScanRay>& rays, const motion::Pose2D& pose) {
@@ -141,6 +149,7 @@ void Slam::SetMapping(bool on) {
     throw std::invalid_argument("localization keeps its known map: it does not map");
   }
   mapping_on_ = on;
+  ResetGate();
 }
 
 void Slam::SetLocalization(bool on) {
@@ -149,6 +158,7 @@ void Slam::SetLocalization(bool on) {
     throw std::invalid_argument("mapping-only SLAM takes its poses from a reference: it does not localize");
   }
   localization_on_ = on;
+  ResetGate();
 }
 
 void Slam::ClearMap() {
@@ -157,6 +167,7 @@ void Slam::ClearMap() {
   const OccupancyGrid& m = mapper_.map();
   mapper_.Reset(OccupancyGrid(m.width(), m.height(), m.resolution(), m.origin_x(), m.origin_y(), 0));
   sensor_stale_ = true;
+  ResetGate();
 }
 
 void Slam::Finish() {

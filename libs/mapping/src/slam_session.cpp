@@ -132,9 +132,7 @@ bool SlamInputs::Add(const msgs::Event& in) {
   if (first_t_us_ < 0) first_t_us_ = in.t_us;
   last_t_us_ = in.t_us;
   msgs::Event retimed;
-  const msgs::Event* placed = Retime(in, &retimed);
-  if (!placed) return false;
-  const msgs::Event& ev = *placed;
+  const msgs::Event& ev = Retime(in, &retimed);
   switch (ev.kind) {
     case EventKind::kOdometry:
       ++odometry_seen_[ev.channel];
@@ -150,13 +148,13 @@ bool SlamInputs::Add(const msgs::Event& in) {
         odometry_channel_ = ev.channel;
       }
       if (!o_.encoder_odometry && Accept(&odometry_channel_, o_.odometry_channel, ev)) {
-        AddOdometry(ev.t_us, std::get<Pose2D>(ev.payload));
+        AddOdometry(ev.t_us, std::get<Pose2D>(ev.payload), ev.stamp_us);
       }
       return true;
     case EventKind::kEncoders:
       if (o_.encoder_odometry && Accept(&encoder_channel_, "", ev)) {
         const auto& e = std::get<msgs::EncoderTicks>(ev.payload);
-        AddOdometry(ev.t_us, wheel_odometry_->Update(e.left_ticks, e.right_ticks));
+        AddOdometry(ev.t_us, wheel_odometry_->Update(e.left_ticks, e.right_ticks), ev.stamp_us);
       }
       return true;
     case EventKind::kGroundTruth:
@@ -194,15 +192,15 @@ const std::vector<TimedPose>& SlamInputs::poses() const {
 
 // The time each message is placed at: its own stamp when the channel's stamps share the log's
 // clock (the robot's measurement time, immune to network bursts), else its arrival time.
-const msgs::Event* SlamInputs::Retime(const msgs::Event& ev, msgs::Event* copy) {
-  if (o_.time_base == "event" || ev.stamp_us == 0) return &ev;
+const msgs::Event& SlamInputs::Retime(const msgs::Event& ev, msgs::Event* copy) {
+  if (o_.time_base == "event" || ev.stamp_us == 0) return ev;
   auto it = stamp_channels_.find(ev.channel);
   if (it == stamp_channels_.end()) {
     const bool same_clock = o_.time_base == "stamp" || std::llabs(ev.stamp_us - ev.t_us) < 2'000'000;
     it = stamp_channels_.emplace(ev.channel, same_clock).first;
     if (!same_clock) mbot::log::Info("slam: " + ev.channel + " stamps use another clock; using arrival times");
   }
-  if (!it->second) return &ev;
+  if (!it->second) return ev;
   // On a channel whose stamps share the log's clock, a stamp seconds away from the arrival is corrupt:
   // placed there it would hold the pose series back (later messages look older) or jump it ahead.
   if (o_.time_base != "stamp" && std::llabs(ev.stamp_us - ev.t_us) > 2'000'000) {
@@ -210,37 +208,15 @@ const msgs::Event* SlamInputs::Retime(const msgs::Event& ev, msgs::Event* copy) 
     mbot::log::WarnOnce("slam:stamp:" + ev.channel,
                         "slam: " + ev.channel + ": a stamp " + std::to_string((ev.stamp_us - ev.t_us) * 1e-6) +
                             " s from its arrival: placed at its arrival (further ones are counted)");
-    return &ev;
+    return ev;
   }
   if (ev.kind != EventKind::kLidar && ev.kind != EventKind::kOdometry && ev.kind != EventKind::kEncoders &&
       ev.kind != EventKind::kGroundTruth && ev.kind != EventKind::kReferencePose) {
-    return &ev;
-  }
-  // A stamp well ahead of its channel's usual lag behind the arrival (the median of the last 15) is
-  // corrupt too, within the 2 s: placed there it would hold the series back until real stamps pass
-  // it, and the motion across that hole would look like a jump (a restart, confirmed by the next
-  // message). A message that arrived late is not judged: it is older, and placed where it belongs.
-  if (o_.time_base != "stamp") {
-    constexpr int64_t kAheadUs = 250'000;
-    std::deque<int64_t>& lags = lags_[ev.channel];
-    const int64_t lag = ev.t_us - ev.stamp_us;
-    if (lags.size() >= 5) {
-      std::vector<int64_t> v(lags.begin(), lags.end());
-      std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-      if (lag < v[v.size() / 2] - kAheadUs) {
-        ++stamps_ahead_;
-        mbot::log::WarnOnce("slam:ahead:" + ev.channel,
-                            "slam: " + ev.channel + ": a stamp " + std::to_string((v[v.size() / 2] - lag) * 1e-6) +
-                                " s ahead of the channel's usual lag (corrupt): dropped (further ones are counted)");
-        return nullptr;
-      }
-    }
-    lags.push_back(lag);
-    if (lags.size() > 15) lags.pop_front();
+    return ev;
   }
   *copy = ev;
   copy->t_us = ev.stamp_us;
-  return copy;
+  return *copy;
 }
 
 // `<lidar>.odom`: the odometry fields of the chosen (or, before the first scan, any) lidar's lines.
@@ -264,10 +240,10 @@ bool SlamInputs::Accept(std::string* chosen, const std::string& wanted, const ms
 
 // Odometry as the filter sees it: continuous across robot restarts, then with the configured
 // perturbations (noise, a kidnapping jump).
-void SlamInputs::AddOdometry(int64_t t_us, const Pose2D& raw) {
+void SlamInputs::AddOdometry(int64_t t_us, const Pose2D& raw, int64_t stamp_us) {
   if (!odometry_.empty() && t_us < odometry_.back().t_us) return;
   const int restarts = continuity_.restarts(), outliers = continuity_.outliers();
-  const Pose2D continuous = continuity_.Update(t_us, raw);
+  const Pose2D continuous = continuity_.Update(t_us, raw, stamp_us);
   if (continuity_.outliers() > outliers) {
     mbot::log::WarnOnce("slam:odometry_outlier",
                         "slam: an odometry message that jumps away and back (corrupt) is "

@@ -149,6 +149,9 @@ void Referee::OnSlamState(int64_t t_us, mapping::SlamState state) {
 }
 
 void Referee::OnMissionStatus(int64_t t_us, const mission::MissionStatus& status) {
+  // A final state stays: a state that is not final arriving after it is an older message that a
+  // faulty link delivered late (the `mixed` run scored a completed exploration as returning_home).
+  if (end_us_ >= 0 && !mission::IsFinal(status.state)) return;
   state_ = status.state, detail_ = status.detail;
   if (mission::IsFinal(status.state) && end_us_ < 0) end_us_ = t_us;
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <queue>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <variant>
@@ -58,17 +59,23 @@ struct SimFidelity::Impl {
   int64_t enc_l = 0, enc_r = 0, sim_l = 0, sim_r = 0;
   double wheel_sq = 0, wheel_sum = 0;
   long long wheel_n = 0;
-  double imu_theta = 0, gyro_sum = 0, yaw_sq = 0, yaw_sum = 0;
+  double gyro_sum = 0, yaw_sq = 0, yaw_sum = 0;
   int gyro_count = 0;
   long long yaw_n = 0;
   // Scans waiting for the truth to pass their last beam.
   std::deque<std::pair<int64_t, msgs::LidarScan>> scans;
   std::vector<double> residuals, spreads;
+  std::mt19937_64 rng{seed ^ 0x51d5f1de11ULL};
+  std::uniform_real_distribution<double> unit{0.0, 1.0};
+  std::normal_distribution<double> noise{0.0, 1.0};
   long long real_none = 0, sim_none = 0;
 
   void Advance(int64_t t_us) {
     if (!robot || t_us <= t0) return;
     robot->AdvanceTo(t_us - t0, &scratch);
+    for (const msgs::Event& e : scratch) {
+      if (e.kind == EventKind::kImu) sim_gyro_sum += std::get<msgs::Imu>(e.payload).gyro_rad_s[2], ++sim_gyro_count;
+    }
     scratch.clear();
     if (sim.empty() || sim.back().t_us < t_us) sim.push_back({t_us, robot->true_pose()});
   }
@@ -90,24 +97,24 @@ struct SimFidelity::Impl {
     enc_l = e.left_ticks, enc_r = e.right_ticks, sim_l = sl, sim_r = sr;
   }
 
+  // The simulated gyro (its noise and bias, as the simulated robot publishes it) against the log's,
+  // each averaged over the same window.
   void Gyro(int64_t t, const msgs::Imu& m) {
-    const double theta = robot->true_pose().theta;
     if (!imu.open) {
       imu = {true, t};
-      imu_theta = theta;
+      sim_gyro_sum = 0, sim_gyro_count = 0;
       return;
     }
     gyro_sum += m.gyro_rad_s[2] * options.gyro_scale, ++gyro_count;
-    sim_turn += motion::WrapAngle(theta - imu_theta);
-    imu_theta = theta;
-    if (t - imu.t < kWindowUs) return;
-    const double d = sim_turn / ((t - imu.t) * 1e-6) - gyro_sum / gyro_count;
+    if (t - imu.t < kWindowUs || sim_gyro_count == 0) return;
+    const double d = sim_gyro_sum / sim_gyro_count - gyro_sum / gyro_count;
     yaw_sq += d * d, yaw_sum += d, ++yaw_n;
     ++r.gyro_samples;
     imu = {true, t};
-    gyro_sum = 0, gyro_count = 0, sim_turn = 0;
+    gyro_sum = 0, gyro_count = 0, sim_gyro_sum = 0, sim_gyro_count = 0;
   }
-  double sim_turn = 0;
+  double sim_gyro_sum = 0;
+  int sim_gyro_count = 0;
 
   // The beams' times on the log's clock: the scan's event time less how far each beam's own stamp
   // lies before the scan's stamp (the two clocks may differ; their differences do not).
@@ -124,8 +131,14 @@ struct SimFidelity::Impl {
       Pose2D pose;
       if (!motion::InterpolateAt(truth, ti, gap, &pose)) continue;
       const Pose2D sensor = pose.Compose(options.lidar_mount);
-      const double sim_range =
-          arena->Raycast(sensor.x, sensor.y, sensor.theta + s.angles_rad[i], options.lidar_max_range_m);
+      // The simulated lidar's range: the ray cast with its noise and dropout (SimLidarOptions).
+      double sim_range = arena->Raycast(sensor.x, sensor.y, sensor.theta + s.angles_rad[i], options.lidar_max_range_m);
+      if (sim_range < options.lidar_max_range_m) {
+        if (unit(rng) < options.robot.lidar.dropout)
+          sim_range = options.lidar_max_range_m;
+        else
+          sim_range += noise(rng) * options.robot.lidar.range_noise_m;
+      }
       const double real = s.ranges_m[i];
       const bool real_return =
           std::isfinite(real) && real >= options.lidar_min_range_m && real < options.lidar_max_range_m;
@@ -233,11 +246,15 @@ SimFidelityResult SimFidelity::Finish() {
   const int64_t gap = static_cast<int64_t>(m.options.max_pose_gap_s * 1e6);
   r.duration_s = (m.truth.back().t_us - m.truth.front().t_us) * 1e-6;
   double turn = 0;
-  for (size_t i = 1; i < m.truth.size(); ++i) {
-    const Pose2D& a = m.truth[i - 1].pose;
-    const Pose2D& b = m.truth[i].pose;
-    r.true_path_m += std::hypot(b.x - a.x, b.y - a.y);
-    turn += std::abs(motion::WrapAngle(b.theta - a.theta));
+  // The path and the turning, counted in steps of at least 1 cm and 0.5° so the motion capture's
+  // jitter (sub-millimetre, every 10 ms) does not add up while the robot stands.
+  Pose2D at = m.truth.front().pose;
+  double heading = at.theta;
+  for (const TimedPose& p : m.truth) {
+    const double step = std::hypot(p.pose.x - at.x, p.pose.y - at.y);
+    if (step >= 0.01) r.true_path_m += step, at = p.pose;
+    const double dtheta = std::abs(motion::WrapAngle(p.pose.theta - heading));
+    if (dtheta >= 0.5 * M_PI / 180) turn += dtheta, heading = p.pose.theta;
   }
   r.true_turn_deg = turn * 180 / M_PI;
   // The log's odometry in the truth frame: anchored where the first truth pose meets it.

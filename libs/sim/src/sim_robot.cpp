@@ -396,14 +396,20 @@ SimRobot::~SimRobot() = default;
 
 bool SimRobot::Command(double v_m_s, double w_rad_s) {
   const SimRobotOptions& o = impl_->o;
-  // NaN fails both comparisons, so it is refused too.
-  if (!(std::abs(v_m_s) <= o.max_command_v_m_s && std::abs(w_rad_s) <= o.max_command_w_rad_s)) {
+  impl_->last_command_us = impl_->now;
+  if (!std::isfinite(v_m_s) || !std::isfinite(w_rad_s)) {  // nothing to hold to: stop
+    impl_->cmd_v = impl_->cmd_w = 0.0;
     ++impl_->commands_refused;
     return false;
   }
-  impl_->cmd_v = v_m_s;
-  impl_->cmd_w = w_rad_s;
-  impl_->last_command_us = impl_->now;
+  // Up to twice a limit the firmware clamps, as mbot_firmware does; beyond that no autonomy asked
+  // for it (a corrupt exponent gives 1e30): refused, and the last good command holds.
+  if (std::abs(v_m_s) > 2 * o.max_command_v_m_s || std::abs(w_rad_s) > 2 * o.max_command_w_rad_s) {
+    ++impl_->commands_refused;
+    return false;
+  }
+  impl_->cmd_v = std::clamp(v_m_s, -o.max_command_v_m_s, o.max_command_v_m_s);
+  impl_->cmd_w = std::clamp(w_rad_s, -o.max_command_w_rad_s, o.max_command_w_rad_s);
   return true;
 }
 

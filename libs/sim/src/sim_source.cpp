@@ -144,11 +144,12 @@ void SimSource::Send(const Event& event) {
   const auto* cmd = std::get_if<MotorCommand>(&event.payload);
   if (!cmd || cmd->kind != MotorCommand::Kind::kVelocity) return;
   if (!robot_->Command(cmd->velocity.v_m_s, cmd->velocity.w_rad_s)) {
-    mbot::log::WarnOnce("sim:command_refused", "sim: velocity command (" + Significant(cmd->velocity.v_m_s, 4) +
-                                                   " m/s, " + Significant(cmd->velocity.w_rad_s, 4) + " rad/s) on " +
-                                                   event.channel +
-                                                   " refused: beyond the firmware's limits (max_command_v_m_s, "
-                                                   "max_command_w_rad_s); further ones are counted");
+    mbot::log::WarnOnce("sim:command_refused",
+                        "sim: velocity command (" + Significant(cmd->velocity.v_m_s, 4) + " m/s, " +
+                            Significant(cmd->velocity.w_rad_s, 4) + " rad/s) on " + event.channel +
+                            " refused: not finite (the robot stops), or beyond twice the firmware's limits "
+                            "(max_command_v_m_s, max_command_w_rad_s: the last good one holds); "
+                            "further ones are counted");
   }
 }
 

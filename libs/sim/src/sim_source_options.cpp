@@ -43,11 +43,11 @@ void ParseSimRobotModel(config::Section& s, SimRobotOptions* robot) {
                                         "(0: never) [s]"),
                                     0.0, 1e4);
   r.max_command_v_m_s = s.GetDouble("max_command_v_m_s", r.max_command_v_m_s,
-                                    doc("the firmware refuses a velocity command faster than this (mbot_firmware's "
-                                        "MAX_FWD_VEL); the last good one holds [m/s]"),
-                                    0.0, 100.0);
+                                    doc("the firmware clamps velocity commands to this (mbot_firmware's MAX_FWD_VEL) "
+                                        "and refuses those over twice it (the last good one holds) [m/s]"),
+                                    0.01, 100.0);
   r.max_command_w_rad_s = s.GetDouble("max_command_w_rad_s", r.max_command_w_rad_s,
-                                      doc("... or turning faster than this (MAX_TURN_VEL) [rad/s]"), 0.0, 1000.0);
+                                      doc("... and turn rates to this (MAX_TURN_VEL) [rad/s]"), 0.01, 1000.0);
   r.ground_truth_rate_hz = s.GetDouble("ground_truth_rate_hz", r.ground_truth_rate_hz,
                                        doc("rate of the TRUE_POSE messages [Hz]"), 1.0, 1000.0);
 

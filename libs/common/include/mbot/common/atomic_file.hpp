@@ -41,6 +41,10 @@ void CommitFile(const std::string& tmp, const std::string& path);
 // A temporary file name beside `path` keeping its extension (so format-by-extension writers work).
 std::string TempPathFor(const std::string& path);
 
+// Removes the temporary files of `path` (TempPathFor's names) that a process no longer running left
+// behind (killed before it could rename or remove them). Returns how many it removed.
+int RemoveStaleTempFiles(const std::string& path);
+
 // Creates `dir` and its parents; throws naming the folder when it cannot.
 void EnsureDirectory(const std::string& dir);
 

@@ -39,7 +39,8 @@ struct SlamOptions {
   // Full SLAM: a scan whose returns fit the map at its pose at under this share of the recent
   // mapped scans' median fit (a corrupt or misplaced scan: a bad stamp, a bad odometry step) is not
   // mapped; 0: off. After gate_max_scans such scans in a row the next is mapped whatever it fits
-  // (the world changed, or the pose was wrong and was corrected: the map must follow).
+  // (the world changed, or the pose was wrong and was corrected: the map must follow). Not while
+  // localization is switched off (the fit is then taken against a map that may be far behind).
   double gate_fit_ratio = 0.5;
   int gate_max_scans = 3;
 };
@@ -132,6 +133,7 @@ class Slam {
  private:
   bool UsesFilter() const { return options_.mode != SlamMode::kMappingOnly; }
   bool Gate(const std::vector<ScanRay>& rays, const motion::Pose2D& pose);
+  void ResetGate();  // a map cleared or switched: the recent fits say nothing of the next
 
   SlamOptions options_;
   LogOddsMapper mapper_;

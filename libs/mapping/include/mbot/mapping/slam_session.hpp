@@ -113,11 +113,11 @@ class SlamInputs {
   void TrimBefore(int64_t t_us);
 
  private:
-  // The event placed at its time, or nullptr for one whose stamp is corrupt (dropped).
-  const msgs::Event* Retime(const msgs::Event& ev, msgs::Event* copy);
+  const msgs::Event& Retime(const msgs::Event& ev, msgs::Event* copy);
   bool Accept(std::string* chosen, const std::string& wanted, const msgs::Event& ev);
   bool ScanLineOdometry(const std::string& channel) const;
-  void AddOdometry(int64_t t_us, const motion::Pose2D& raw);
+  // `stamp_us`: the message's own stamp (0: none), which tells a duplicate when t_us is its arrival.
+  void AddOdometry(int64_t t_us, const motion::Pose2D& raw, int64_t stamp_us);
 
   const SlamSessionOptions& o_;
   motion::OdometryContinuity continuity_;
@@ -188,9 +188,10 @@ class SlamSession {
   }
 
   // Streams the records: each goes to `sink` once its pose is final and its truth and reference
-  // are paired (full SLAM, localization: a few scans behind; graph SLAM: all at Finish, with the
-  // optimised poses), and is then dropped, so a run of any length holds a bounded number. Without
-  // a sink every record is kept (records()).
+  // are paired — full SLAM and localization: as soon as both series have passed it, or once it is
+  // min(4 × max_pose_gap_s, 60 s) + 1 s old (a series that stopped or never started: 3 s by
+  // default); graph SLAM: all at Finish, with the optimised poses — and is then dropped, so a run of
+  // any length holds a bounded number. Without a sink every record is kept (records()).
   void StreamRecords(std::function<void(const ScanRecord&)> sink) { sink_ = std::move(sink); }
 
   const SlamSessionOptions& options() const { return o_; }

@@ -3,12 +3,12 @@
 // path is what is compared, and a wall would stop a simulated robot that drifted into it), and what
 // it does is set against what the real robot did:
 //  - wheel speeds against the log's encoders, each over the same encoder interval;
-//  - yaw rate against the log's gyro;
+//  - yaw rate: the simulated gyro (its noise and bias) against the log's gyro;
 //  - the path against TRUE_POSE: the position error at the end per metre the real robot drove, and
 //    the heading error per full turn it made, beside the same measures of the log's own odometry;
-//  - the lidar: at each real beam, the range the simulator's ray cast gives from the true pose at the
-//    beam's own time in a map of the arena, against the real range (residuals, no-return rates, the
-//    spread of beam times within a scan).
+//  - the lidar: at each real beam, the range the simulated lidar gives (the ray cast with its noise
+//    and dropout) from the true pose at the beam's own time in a map of the arena, against the real
+//    range (residuals, no-return rates, the spread of beam times within a scan).
 // Every message is placed at its own stamp when that shares the log's clock (a legacy log's robot
 // streams reached the logger in bursts up to 1.6 s late; the motion capture was stamped on arrival):
 // the commands drive the simulated robot when the robot sent them, not when they were logged.

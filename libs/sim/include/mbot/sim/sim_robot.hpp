@@ -84,9 +84,9 @@ struct SimRobotOptions {
   double slip_interval_s = 0.05;                  // the slip of each wheel is redrawn this often (not white)
   double physics_dt_s = 0.002;
   double command_timeout_s = 1.0;  // the firmware stops the motors after this long without a command (0: never)
-  // The firmware's limits on a velocity command (mbot_firmware's MAX_FWD_VEL, MAX_TURN_VEL): no
-  // working autonomy asks for more, so on a bus that corrupts such a command is the corruption. It
-  // is refused and the last good command holds.
+  // The firmware's limits on a velocity command (mbot_firmware's MAX_FWD_VEL, MAX_TURN_VEL): a
+  // command up to twice them is clamped to them; beyond that no autonomy asked for it — on a bus
+  // that corrupts, it is the corruption — and it is refused (the last good command holds).
   double max_command_v_m_s = 0.8;
   double max_command_w_rad_s = 2.5;
   // A contact ends (and the next one counts again) once the footprint grown by this much is clear.
@@ -107,9 +107,10 @@ class SimRobot {
   SimRobot(World& world, const SimRobotOptions& options, const motion::Pose2D& start, uint64_t seed);
   ~SimRobot();
 
-  // The latest velocity command (MBOT_VEL_CMD): held until the next one. Refused (false; the last
-  // good one holds) when not finite or beyond the firmware's limits. (Its stamp is not judged: an
-  // autonomy stamps a command with the time of the message it answers, which a bus may deliver late.)
+  // The latest velocity command (MBOT_VEL_CMD): held until the next one, clamped to the firmware's
+  // limits. Refused (false) when beyond twice them (the last good command holds) or not finite
+  // (the robot stops). Its stamp is not judged: an autonomy stamps a command with the time of the
+  // message it answers, which a bus may deliver late.
   bool Command(double v_m_s, double w_rad_s);
   int commands_refused() const;
   // The forklift's target height (MBOT_FORKLIFT_CMD); false when the robot has no forklift. A height
