@@ -236,6 +236,27 @@ TEST(MissionRecovery, BacksOffWhenStalledAndGivesUpAfterMaxStalls) {
   EXPECT_GT(reversing, 10);
 }
 
+// A stall while driving marks what the robot ran into on the map it plans on, ahead of it: against
+// the free end of a wall the map's end is short of the real one, and the next plan must not graze
+// it again.
+TEST(MissionRecovery, AStallMarksAnObstacleAheadOnTheMapItPlansOn) {
+  auto room = std::make_shared<const mapping::OccupancyGrid>(Room(-1, -1, 3, 3));
+  Mission m(Parse("task = explore\nstart_delay_s = 0\nrobot_radius_m = 0.1\nstuck_s = 0.5\n"), 1);
+  KinematicRun run(m, {0, 0, 0});
+  run.reveal = [&](const Pose2D&) { return room; };
+  run.Run(0.5);
+  m.OnGoal({1.5, 0.0, 0});
+  run.Run(1.0);
+  run.stuck = true;
+  run.Run(1.0);
+  ASSERT_GE(m.Report().bumps, 1);
+  ASSERT_TRUE(m.map());
+  int cx = 0, cy = 0;
+  m.map()->WorldToCell(run.truth.x + 0.12, run.truth.y, &cx, &cy);
+  EXPECT_EQ(m.map()->at(cx, cy), 127);
+  EXPECT_EQ(room->at(cx, cy) == 127, false);  // SLAM's own map is not changed
+}
+
 TEST(MissionState, NamesRoundTrip) {
   for (MissionState s : {MissionState::kInitializing, MissionState::kReturningHome, MissionState::kSettingDown,
                          MissionState::kCompleted, MissionState::kFailed}) {

@@ -51,7 +51,37 @@ void Mission::OnPoseEstimate(int64_t t_us, const Pose2D& pose) {
   if (first_slam_us_ < 0) first_slam_us_ = t_us;
 }
 
-void Mission::OnMap(std::shared_ptr<const mapping::OccupancyGrid> map) { map_ = std::move(map); }
+void Mission::OnMap(std::shared_ptr<const mapping::OccupancyGrid> map) {
+  raw_map_ = std::move(map);
+  MarkBumps();
+}
+
+// The map the tasks plan on: SLAM's, with a disc of kBumpRadiusM occupied at each recent bump.
+void Mission::MarkBumps() {
+  constexpr double kBumpRadiusM = 0.03;
+  const int64_t keep_us = static_cast<int64_t>(o_.bump_keep_s * 1e6);
+  bumps_.erase(std::remove_if(bumps_.begin(), bumps_.end(),
+                              [&](const motion::TimedPose& b) { return t_us_ - b.t_us > keep_us; }),
+               bumps_.end());
+  if (!raw_map_ || bumps_.empty()) {
+    map_ = raw_map_;
+    return;
+  }
+  auto marked = std::make_shared<mapping::OccupancyGrid>(*raw_map_);
+  const double res = marked->resolution();
+  const int reach = static_cast<int>(std::ceil(kBumpRadiusM / res));
+  for (const motion::TimedPose& b : bumps_) {
+    int cx = 0, cy = 0;
+    marked->WorldToCell(b.pose.x, b.pose.y, &cx, &cy);
+    for (int dy = -reach; dy <= reach; ++dy) {
+      for (int dx = -reach; dx <= reach; ++dx) {
+        if (std::hypot(dx, dy) * res > kBumpRadiusM + 0.5 * res || !marked->IsInside(cx + dx, cy + dy)) continue;
+        marked->at(cx + dx, cy + dy) = 127;
+      }
+    }
+  }
+  map_ = std::move(marked);
+}
 
 void Mission::OnSlamState(mapping::SlamState state) { slam_state_ = state; }
 
@@ -76,7 +106,7 @@ MissionReport Mission::Report() const {
   r.task = o_.task;
   r.status = status_;
   r.commands = commands_, r.paths = paths_, r.stale_pose_stops = stale_stops_;
-  r.corrections = total_corrections_, r.stall_recoveries = recoveries_;
+  r.corrections = total_corrections_, r.stall_recoveries = recoveries_, r.bumps = bumps_marked_;
   r.odometry_restarts = continuity_.restarts();
   r.rounds = rounds_ + 1;
   task_->AddToReport(&r);
@@ -167,7 +197,18 @@ bool Mission::Recovering() {
     return true;
   }
   ++recoveries_;
-  mbot::log::Warn("mission: stalled for " + Significant(o_.stuck_s, 3) + " s while commanded to move: backing off");
+  std::string marked;
+  Pose2D at;
+  if (o_.bump_ahead_m > 0 && std::abs(last_command_.v_m_s) > 0.05 && PoseNow(&at)) {
+    const Pose2D bump = at.Compose({std::copysign(o_.bump_ahead_m, last_command_.v_m_s), 0, 0});
+    bumps_.push_back({t_us_, bump});
+    if (bumps_.size() > 32) bumps_.erase(bumps_.begin());
+    ++bumps_marked_;
+    MarkBumps();
+    marked = "; an obstacle marked at (" + Significant(bump.x, 3) + ", " + Significant(bump.y, 3) + ")";
+  }
+  mbot::log::Warn("mission: stalled for " + Significant(o_.stuck_s, 3) + " s while commanded to move: backing off" +
+                  marked);
   stuck_since_us_ = -1;
   last_command_ = {};
   backoff_until_us_ = t_us_ + static_cast<int64_t>(o_.backoff_s * 1e6);

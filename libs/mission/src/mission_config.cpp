@@ -76,6 +76,11 @@ MissionOptions ParseMissionOptions(config::Section& s) {
   o.max_stalls = static_cast<int>(
       s.GetInt("max_stalls", o.max_stalls, "stalls on the way to one goal before the mission fails", 0, 100000));
   o.backoff_s = s.GetDouble("backoff_s", o.backoff_s, "how long to reverse at 0.1 m/s when stalled [s]", 0.0, 10.0);
+  o.bump_ahead_m = s.GetDouble("bump_ahead_m", o.bump_ahead_m,
+                               "a stall while driving marks an obstacle this far ahead of the robot's centre on the "
+                               "map it plans on (0: off) [m]",
+                               0.0, 1.0);
+  o.bump_keep_s = s.GetDouble("bump_keep_s", o.bump_keep_s, "... kept this long [s]", 0.0, 1e6);
   o.dwell_s = s.GetDouble("dwell_s", o.dwell_s,
                           "warehouse: how long to stand at a target or drop-off [s] (the rules ask " +
                               std::to_string(static_cast<int>(warehouse::kDwellS)) + " s)",

@@ -13,6 +13,7 @@ Json MissionJson(const mission::MissionReport& r, bool interrupted, bool frontie
   j["stale_pose_stops"] = r.stale_pose_stops;
   j["corrections"] = r.corrections;
   j["stall_recoveries"] = r.stall_recoveries;
+  j["bumps"] = r.bumps;
   j["odometry_restarts"] = r.odometry_restarts;
   j["rounds"] = r.rounds;
   if (r.task == mission::TaskKind::kWarehouse) {

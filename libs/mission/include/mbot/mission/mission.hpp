@@ -94,7 +94,13 @@ struct MissionOptions {
   double stuck_s = 1.0;     // commanded to move but not moving this long: back off
   double backoff_s = 0.6;   // reversing at 0.1 m/s
   int max_stalls = 10;      // stalls on the way to one goal before the mission gives up
-  double dwell_s = 2.5;     // warehouse: standing at a stop (lifting, setting down) [s]
+  // A stall while driving marks what the robot ran into on the map it plans on: a small obstacle
+  // this far ahead of its centre (behind when reversing), kept for bump_keep_s. Against the free
+  // end of a wall, the map's wall is a little short of the real one and the plan would graze the
+  // real end again and again (0: off).
+  double bump_ahead_m = 0.12;
+  double bump_keep_s = 120.0;
+  double dwell_s = 2.5;  // warehouse: standing at a stop (lifting, setting down) [s]
   // A person at the viewer: teleop drives only while its commands keep coming (the dead man).
   double teleop_timeout_s = 0.5;
   HeavyLiftOptions heavy_lift;
@@ -123,6 +129,7 @@ struct MissionReport {
   MissionStatus status;
   long long commands = 0, paths = 0, stale_pose_stops = 0;
   int corrections = 0, stall_recoveries = 0;
+  int bumps = 0;              // obstacles marked where the robot stalled
   int odometry_restarts = 0;  // the robot's odometry started again from zero (a firmware restart)
   int rounds = 1;             // rounds of the task run (repeat + 1 when all completed)
   // explore: the frontiers left on the map at home (none when completed).
@@ -214,7 +221,10 @@ class Mission {
   int64_t first_slam_us_ = -1, last_control_us_ = -1;
   std::vector<motion::TimedPose> odometry_;  // the last ~5 s, continuous across robot restarts
   motion::OdometryContinuity continuity_;
-  std::shared_ptr<const mapping::OccupancyGrid> map_;
+  std::shared_ptr<const mapping::OccupancyGrid> map_;      // SLAM's map with the bumps marked
+  std::shared_ptr<const mapping::OccupancyGrid> raw_map_;  // SLAM's map as it came
+  std::vector<motion::TimedPose> bumps_;                   // where stalls met something, and when
+  void MarkBumps();
   std::optional<mapping::SlamState> slam_state_;
   std::optional<ForkliftState> forklift_;
   bool final_leg_ = false;  // the path ends at goal_, where the robot must stop within the tolerances
@@ -225,7 +235,7 @@ class Mission {
   motion::Pose2D stall_goal_{1e9, 1e9, 0};  // the goal the stall budget is for
   MissionStatus status_;
   long long commands_ = 0, paths_ = 0, stale_stops_ = 0;
-  int corrections_ = 0, total_corrections_ = 0, recoveries_ = 0, stalls_this_goal_ = 0;
+  int corrections_ = 0, total_corrections_ = 0, recoveries_ = 0, stalls_this_goal_ = 0, bumps_marked_ = 0;
   motion::VelocityCommand last_command_;
   bool ManualStep(const motion::Pose2D& pose, double dt);
   bool watched_ = false;
