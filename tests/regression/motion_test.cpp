@@ -112,12 +112,11 @@ TEST(SimFidelityRegression, DriveSquareIsComparedStreamByStream) {
 }
 
 // A log where the robot stands still: nothing to divide the drift by (null in fidelity.json), the
-// lidar still compared.
+// lidar still compared, on the map found beside the log (arena_map = auto).
 TEST(SimFidelityRegression, AStandingLogHasNoDriftButItsScansAreCompared) {
   const std::string j =
       RunConfig("sim_fidelity.ini", "fidelity_sweep_convex",
-                {"source.path=${datasets}/botlab/legacy_2017/sweep_convex_10mx10m_5cm.log",
-                 "fidelity.arena_map=${datasets}/botlab/legacy_2017/maps/sweep_convex_10mx10m_5cm.map"},
+                {"source.path=${datasets}/botlab/legacy_2017/sweep_convex_10mx10m_5cm.log"},  // its map: auto
                 "fidelity.json");
   EXPECT_NE(j.find("\"path_drift_m_per_m\": null"), std::string::npos) << j;
   EXPECT_GT(Get(j, {"beams_compared"}), 15000);

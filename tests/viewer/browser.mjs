@@ -146,7 +146,7 @@ async function extras(page) {
   // .crdownload over it: a file is there once it has bytes and no partial download is left.
   const saved = () => ["map.pgm", "map.yaml", "map.png"].every((n) => existsSync(join(dir, n)) && statSync(join(dir, n)).size > 0) &&
     !readdirSync(dir).some((n) => n.endsWith(".crdownload"));
-  for (let i = 0; i < 100 && !saved(); ++i) await sleep(100);
+  for (let i = 0; i < 300 && !saved(); ++i) await sleep(100);  // up to 30 s: the suite may load both cores
   const pgmOk = existsSync(join(dir, "map.pgm")) && existsSync(join(dir, "map.yaml"));
   let header = "", yaml = "";
   if (pgmOk) {

@@ -3,6 +3,7 @@
 // fidelity.json, the paths on the arena map (fidelity_paths.png) and the lidar's range residuals
 // (fidelity_residuals.csv and .png).
 #include <cmath>
+#include <filesystem>
 #include <optional>
 
 #include "mbot/common/atomic_file.hpp"
@@ -33,6 +34,16 @@ class SimFidelityStage : public Stage {
 
   void Start(const RunContext& ctx) override {
     std::optional<sim::World> arena;
+    if (o_.arena_map == "auto") {
+      // The botlab layout: a log's map is maps/<the log's name>.map beside it.
+      const std::filesystem::path log(ctx.source_path);
+      const std::filesystem::path map = log.parent_path() / "maps" / (log.stem().string() + ".map");
+      std::error_code ec;
+      o_.arena_map = std::filesystem::is_regular_file(map, ec) ? map.string() : "";
+      if (o_.arena_map.empty())
+        mbot::log::Info("sim_fidelity: no arena map beside the log (" + map.string() +
+                        "): the lidar is not compared (set arena_map)");
+    }
     if (!o_.arena_map.empty()) {
       arena = sim::World::Load(o_.arena_map);
       map_ = drivers::ReadAnyMap(o_.arena_map);
@@ -171,9 +182,10 @@ const RegisterStage kSimFidelityRegistered{
                                                 "the residual histogram's bin width [m]", 1e-4, 1.0);
        f.residual_histogram_range_m = s.GetDouble("residual_range_m", f.residual_histogram_range_m,
                                                   "the residual histogram spans +- this [m]", 1e-3, 10.0);
-       o.arena_map = s.GetPath("arena_map", "",
+       o.arena_map = s.GetPath("arena_map", "auto",
                                "a map of the logged arena in the motion-capture frame (any map format; unknown and "
-                               "occupied cells are walls); empty: no lidar comparison");
+                               "occupied cells are walls); auto: maps/<log name>.map beside the log; empty: no "
+                               "lidar comparison");
        return std::make_unique<SimFidelityStage>(o);
      }}};
 
