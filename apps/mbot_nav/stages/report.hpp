@@ -8,17 +8,13 @@
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/motion/pose2d.hpp"
+#include "mbot/motion/tum.hpp"
 #include "mbot/reports/json.hpp"
 
 namespace mbot::app {
 
-// One TUM trajectory line, "t x y z qx qy qz qw", for a planar pose at t seconds.
-inline std::string TumLine(double t_s, double x, double y, double theta) {
-  char line[160];
-  std::snprintf(line, sizeof line, "%.6f %.6f %.6f 0 0 0 %.9f %.9f\n", t_s, x, y, std::sin(theta / 2),
-                std::cos(theta / 2));
-  return line;
-}
+using motion::TumHeader;
+using motion::TumLine;
 
 // A number for a printed line (6 significant digits); non-finite values print as null.
 using reports::Num;
@@ -28,7 +24,7 @@ using reports::Num;
 inline void WriteTum(const std::string& path, const std::string& what, const std::vector<motion::TimedPose>& poses,
                      const motion::Pose2D& frame = {}) {
   WriteFileAtomically(path, [&](std::ostream& o) {
-    o << "# " << what << (what.empty() ? "" : ": ") << "t x y z qx qy qz qw\n";
+    o << TumHeader(what);
     for (const motion::TimedPose& p : poses) {
       const motion::Pose2D w = frame.Compose(p.pose);
       o << TumLine(p.t_us * 1e-6, w.x, w.y, w.theta);

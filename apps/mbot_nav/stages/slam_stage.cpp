@@ -33,7 +33,9 @@ class SlamStage : public Stage {
                       "x" + std::to_string(known->height()) + ")");
     }
     session_.emplace(options_.session, ctx.seed, std::move(known));
-    records_.emplace(ctx.output_dir, options_);
+    records_.emplace(ctx.output_dir, mapping::SlamRecordOptions{mapping::ToString(options_.session.slam.mode),
+                                                                options_.tum_stamps, options_.truth_is_reference,
+                                                                options_.score_from_us, options_.score_max_latency_us});
     session_->StreamRecords(
         [this](const mapping::ScanRecord& r) { records_->Add(r, session_->inputs().first_t_us()); });
     wall_start_ = std::chrono::steady_clock::now();
@@ -86,7 +88,7 @@ class SlamStage : public Stage {
 
   SlamStageOptions options_;
   std::optional<mapping::SlamSession> session_;
-  std::optional<SlamRecordWriter> records_;  // the per-scan outputs, streamed to disk
+  std::optional<mapping::SlamRecordWriter> records_;  // the per-scan outputs, streamed to disk
   std::vector<msgs::Event> out_;
   Bus* bus_ = nullptr;
   std::chrono::steady_clock::time_point wall_start_;
