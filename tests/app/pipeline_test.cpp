@@ -33,7 +33,7 @@ TEST(PipelineTest, UnknownStageTypeListsTheKnownOnes) {
   const auto e = ErrorOf(std::string(kBase) + "[s]\ntype = nope\n");
   EXPECT_NE(
       e.find("t.ini:6: [s] type: unknown stage type 'nope' (known: action_model_fit, astar_test, camera_calibration, "
-             "exploration, "
+             "exploration, fit_sim_model, "
              "inspect, lcm_bridge, map_writer, maze_generator, merge_sweep, mission, motor_calibration, "
              "movingai_benchmark, "
              "odometry, "

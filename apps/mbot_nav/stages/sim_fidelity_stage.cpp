@@ -11,7 +11,6 @@
 #include "mbot/common/log.hpp"
 #include "mbot/drivers/map_io.hpp"
 #include "mbot/drivers/plot.hpp"
-#include "mbot/motion/motion_config.hpp"
 #include "mbot/reports/json.hpp"
 #include "mbot/sim/sim_fidelity.hpp"
 #include "mbot/sim/sim_source_options.hpp"
@@ -165,19 +164,7 @@ const RegisterStage kSimFidelityRegistered{
      [](config::Section& s) -> std::unique_ptr<Stage> {
        FidelityStageOptions o;
        sim::SimFidelityOptions& f = o.fidelity;
-       // The logged robot: its wheel constants are the log's encoders' and the simulated robot's.
-       f.log_wheels = motion::ParseWheelConstants(s, &f.robot.geometry);
-       sim::ParseSimRobotModel(s, &f.robot);
-       f.lidar_min_range_m = f.robot.lidar.min_range_m;
-       f.lidar_max_range_m = f.robot.lidar.max_range_m;
-       const config::PoseValue mount =
-           s.GetPose("lidar_mount", {}, "the lidar's pose on the logged robot: x [m], y [m], theta [deg]");
-       f.lidar_mount = {mount.x_m, mount.y_m, mount.theta_rad};
-       f.robot.lidar.mount = f.lidar_mount;
-       f.gyro_scale = s.GetDouble("gyro_scale", f.gyro_scale,
-                                  "multiplies the log's gyro yaw rate into rad/s (0.0174533 for deg/s)", -100.0, 100.0);
-       f.max_pose_gap_s = s.GetDouble("max_pose_gap_s", f.max_pose_gap_s,
-                                      "motion-capture poses further apart are not interpolated [s]", 0.001, 10.0);
+       f = sim::ParseSimFidelityOptions(s);
        f.residual_histogram_bin_m = s.GetDouble("residual_bin_m", f.residual_histogram_bin_m,
                                                 "the residual histogram's bin width [m]", 1e-4, 1.0);
        f.residual_histogram_range_m = s.GetDouble("residual_range_m", f.residual_histogram_range_m,

@@ -56,7 +56,11 @@ struct SimFidelity::Impl {
     int64_t t = 0;
   };
   Window enc, imu;
-  int64_t enc_l = 0, enc_r = 0, sim_l = 0, sim_r = 0;
+  int64_t enc_l = 0, enc_r = 0;
+  double sim_l = 0, sim_r = 0;  // the simulated wheels' rotations at the window's start [rad]
+  int64_t log_t0 = -1;          // the log's first truth time (begin_s and end_s count from it)
+  int64_t last_truth_us = -1;
+  bool comparing = false;  // past begin_s
   double wheel_sq = 0, wheel_sum = 0;
   long long wheel_n = 0;
   double gyro_sum = 0, yaw_sq = 0, yaw_sum = 0;
@@ -73,6 +77,7 @@ struct SimFidelity::Impl {
   void Advance(int64_t t_us) {
     if (!robot || t_us <= t0) return;
     robot->AdvanceTo(t_us - t0, &scratch);
+    if (!comparing) return scratch.clear();
     for (const msgs::Event& e : scratch) {
       if (e.kind == EventKind::kImu) sim_gyro_sum += std::get<msgs::Imu>(e.payload).gyro_rad_s[2], ++sim_gyro_count;
     }
@@ -81,16 +86,17 @@ struct SimFidelity::Impl {
   }
 
   void Encoders(int64_t t, const msgs::EncoderTicks& e) {
-    const motion::WheelOdometryOptions sim_wheels = options.robot.geometry.Odometry();
-    const int64_t sl = robot->left_ticks(), sr = robot->right_ticks();
+    const double radius = options.robot.geometry.wheel_radius_m;
+    const double sl = robot->left_wheel_angle_rad(), sr = robot->right_wheel_angle_rad();
     if (enc.open && t - enc.t < kWindowUs) return;
     if (enc.open) {
       const double dt = (t - enc.t) * 1e-6;
       const double real_l = (e.left_ticks - enc_l) * options.log_wheels.left_m_per_tick / dt;
       const double real_r = (e.right_ticks - enc_r) * options.log_wheels.right_m_per_tick / dt;
-      const double sim_lv = (sl - sim_l) * sim_wheels.left_m_per_tick / dt;
-      const double sim_rv = (sr - sim_r) * sim_wheels.right_m_per_tick / dt;
+      const double sim_lv = (sl - sim_l) * radius / dt;
+      const double sim_rv = (sr - sim_r) * radius / dt;
       for (const double d : {sim_lv - real_l, sim_rv - real_r}) wheel_sq += d * d, wheel_sum += d, ++wheel_n;
+      r.wheel_windows.push_back({(t - log_t0) * 1e-6, real_l, real_r, sim_lv, sim_rv});
       ++r.encoder_samples;
     }
     enc = {true, t};
@@ -107,8 +113,10 @@ struct SimFidelity::Impl {
     }
     gyro_sum += m.gyro_rad_s[2] * options.gyro_scale, ++gyro_count;
     if (t - imu.t < kWindowUs || sim_gyro_count == 0) return;
-    const double d = sim_gyro_sum / sim_gyro_count - gyro_sum / gyro_count;
+    const double sim_rate = sim_gyro_sum / sim_gyro_count, real_rate = gyro_sum / gyro_count;
+    const double d = sim_rate - real_rate;
     yaw_sq += d * d, yaw_sum += d, ++yaw_n;
+    r.yaw_windows.push_back({(t - log_t0) * 1e-6, real_rate, sim_rate});
     ++r.gyro_samples;
     imu = {true, t};
     gyro_sum = 0, gyro_count = 0, sim_gyro_sum = 0, sim_gyro_count = 0;
@@ -180,27 +188,40 @@ SimFidelity::~SimFidelity() = default;
 
 void SimFidelity::Impl::Process(const msgs::Event& ev, int64_t t) {
   Impl& m = *this;
+  if (ev.kind == EventKind::kGroundTruth && m.log_t0 < 0) m.log_t0 = t;
+  if (m.log_t0 < 0) return;  // before motion capture: nothing to compare with
+  const double since_s = (t - m.log_t0) * 1e-6;
+  if (since_s > m.options.end_s) return;
   if (ev.kind == EventKind::kGroundTruth) {
     const Pose2D& p = std::get<Pose2D>(ev.payload);
-    if (!m.truth.empty() && t < m.truth.back().t_us) return;
-    m.truth.push_back({t, p});
+    if (t < m.last_truth_us) return;
+    m.last_truth_us = t;
     if (!m.robot) {
       // The simulated robot starts where motion capture first saw the real one, at rest.
       m.robot = std::make_unique<SimRobot>(m.empty, m.options.robot, p, m.seed);
       m.t0 = t;
-      m.sim.push_back({t, p});
     }
     m.Advance(t);
+    if (!m.comparing && since_s >= m.options.begin_s) {
+      // The compared part begins: the simulated robot (still moving as it was) is re-placed where the
+      // real one is.
+      m.comparing = true;
+      if (m.options.begin_s > 0) m.robot->Place(p);
+      m.sim.push_back({t, p});
+    }
+    if (!m.comparing) return;
+    m.truth.push_back({t, p});
     if (m.arena) m.FlushScans(false);
     return;
   }
   if (!m.robot) return;  // before motion capture: nothing to compare with
   m.Advance(t);
+  if (!m.comparing && ev.kind != EventKind::kMotorCommand) return;
   switch (ev.kind) {
     case EventKind::kMotorCommand: {
       const auto& c = std::get<msgs::MotorCommand>(ev.payload);
       if (c.kind != msgs::MotorCommand::Kind::kVelocity) return;
-      ++m.r.commands;
+      m.r.commands += m.comparing;
       m.r.commands_refused += !m.robot->Command(c.velocity.v_m_s, c.velocity.w_rad_s);
       return;
     }

@@ -426,6 +426,8 @@ int SimRobot::forklift_commands_clamped() const { return impl_->fork_clamped; }
 
 void SimRobot::AdvanceTo(int64_t t_us, std::vector<Event>* out) { impl_->AdvanceTo(t_us, out); }
 
+void SimRobot::Place(const motion::Pose2D& pose) { impl_->pose = pose; }
+
 int64_t SimRobot::now_us() const { return impl_->now; }
 const motion::Pose2D& SimRobot::true_pose() const { return impl_->pose; }
 int SimRobot::collisions() const { return impl_->collisions; }
@@ -433,6 +435,8 @@ bool SimRobot::in_contact() const { return impl_->contact; }
 double SimRobot::distance_travelled_m() const { return impl_->distance; }
 double SimRobot::left_wheel_speed_rad_s() const { return impl_->w_l; }
 double SimRobot::right_wheel_speed_rad_s() const { return impl_->w_r; }
+double SimRobot::left_wheel_angle_rad() const { return impl_->angle_l; }
+double SimRobot::right_wheel_angle_rad() const { return impl_->angle_r; }
 int64_t SimRobot::left_ticks() const { return impl_->Ticks(impl_->angle_l, impl_->o.geometry.left_encoder_polarity); }
 int64_t SimRobot::right_ticks() const { return impl_->Ticks(impl_->angle_r, impl_->o.geometry.right_encoder_polarity); }
 double SimRobot::gyro_bias_rad_s() const { return impl_->bias; }

@@ -7,6 +7,8 @@
 
 #include "mbot/common/config.hpp"
 #include "mbot/common/strings.hpp"
+#include "mbot/motion/motion_config.hpp"
+#include "mbot/sim/sim_fidelity.hpp"
 #include "mbot/vision/camera_calibration.hpp"
 #include "mbot/vision/vision_config.hpp"
 
@@ -38,6 +40,12 @@ void ParseSimRobotModel(config::Section& s, SimRobotOptions* robot) {
                       "messages [Hz]"),
                   5.0, 1000.0);
   r.controller.dt_s = 1.0 / firmware_rate_hz;
+  r.controller.v_time_constant_s =
+      s.GetDouble("firmware_v_time_constant_s", r.controller.v_time_constant_s,
+                  doc("the firmware's low-pass filter on the commanded forward speed [s]"), 0.0, 10.0);
+  r.controller.w_time_constant_s =
+      s.GetDouble("firmware_w_time_constant_s", r.controller.w_time_constant_s,
+                  doc("the firmware's low-pass filter on the commanded turn rate [s]"), 0.0, 10.0);
   r.command_timeout_s = s.GetDouble("command_timeout_s", r.command_timeout_s,
                                     doc("the firmware stops the motors after this long without a velocity command "
                                         "(0: never) [s]"),
@@ -71,6 +79,24 @@ void ParseSimRobotModel(config::Section& s, SimRobotOptions* robot) {
   l.range_noise_m =
       s.GetDouble("lidar_range_noise_m", l.range_noise_m, doc("lidar range noise, standard deviation [m]"), 0.0, 1.0);
   l.dropout = s.GetDouble("lidar_dropout", l.dropout, doc("probability that a lidar beam gives no return"), 0.0, 1.0);
+}
+
+SimFidelityOptions ParseSimFidelityOptions(config::Section& s) {
+  SimFidelityOptions f;
+  // The logged robot: its wheel constants are the log's encoders' and the simulated robot's.
+  f.log_wheels = motion::ParseWheelConstants(s, &f.robot.geometry);
+  ParseSimRobotModel(s, &f.robot);
+  f.lidar_min_range_m = f.robot.lidar.min_range_m;
+  f.lidar_max_range_m = f.robot.lidar.max_range_m;
+  const config::PoseValue mount =
+      s.GetPose("lidar_mount", {}, "the lidar's pose on the logged robot: x [m], y [m], theta [deg]");
+  f.lidar_mount = {mount.x_m, mount.y_m, mount.theta_rad};
+  f.robot.lidar.mount = f.lidar_mount;
+  f.gyro_scale = s.GetDouble("gyro_scale", f.gyro_scale,
+                             "multiplies the log's gyro yaw rate into rad/s (0.0174533 for deg/s)", -100.0, 100.0);
+  f.max_pose_gap_s = s.GetDouble("max_pose_gap_s", f.max_pose_gap_s,
+                                 "motion-capture poses further apart are not interpolated [s]", 0.001, 10.0);
+  return f;
 }
 
 SimSourceOptions ParseSimSourceOptions(config::Section& s) {

@@ -39,6 +39,21 @@ struct SimFidelityOptions {
   motion::Pose2D lidar_mount;
   double residual_histogram_bin_m = 0.01;  // the residual histogram's bins, over ±histogram_range_m
   double residual_histogram_range_m = 0.3;
+  // The part of the log compared, in seconds from its first motion-capture pose: the simulated robot
+  // starts at the first truth pose at or after begin_s (at rest), and events after end_s are not
+  // taken (a fit on one part of a log, held out on the rest).
+  double begin_s = 0.0;
+  double end_s = 1e300;
+};
+
+// One comparison window (at least 0.2 s; `t_s` is its end since the log's first truth pose). Wheel
+// speeds are forward-positive ground speeds of the wheels' rotation [m/s]; the simulated one is the
+// unquantised rotation (its encoders' ticks differ by under a tick).
+struct WheelWindow {
+  double t_s = 0, real_left = 0, real_right = 0, sim_left = 0, sim_right = 0;
+};
+struct YawWindow {
+  double t_s = 0, real = 0, sim = 0;  // mean gyro yaw rate over the window [rad/s]
 };
 
 struct SimFidelityResult {
@@ -58,7 +73,9 @@ struct SimFidelityResult {
   double scan_range_residual_p95_m = 0;     // of |residual|
   double scan_range_residual_signed_median_m = 0;
   double no_return_rate_real = 0, no_return_rate_sim = 0;
-  double beam_time_spread_real_s = 0;         // median over scans of (last − first beam time)
+  double beam_time_spread_real_s = 0;  // median over scans of (last − first beam time)
+  std::vector<WheelWindow> wheel_windows;
+  std::vector<YawWindow> yaw_windows;
   std::vector<long long> residual_histogram;  // signed residuals, bins of residual_histogram_bin_m from −range
   // For plotting: the paths in the truth frame (odometry anchored at the first truth pose).
   // fidelity_series: at each simulated sample, its time since the first truth pose, and the log's

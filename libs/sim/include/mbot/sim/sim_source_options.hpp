@@ -33,6 +33,11 @@ struct SimSourceOptions {
 // ParseSimSourceOptions reads for it (sim_fidelity reads the same ones for the robot it measures).
 void ParseSimRobotModel(config::Section& section, SimRobotOptions* robot);
 
+// The robot a log recorded and the simulated one compared with it (sim_fidelity, fit_sim_model): its
+// wheel constants, the simulator's model keys, its gyro's unit, its lidar's pose and range limits.
+struct SimFidelityOptions;
+SimFidelityOptions ParseSimFidelityOptions(config::Section& section);
+
 // Reads the simulator's keys of [source]. Throws config::ConfigError naming the key.
 SimSourceOptions ParseSimSourceOptions(config::Section& section);
 
