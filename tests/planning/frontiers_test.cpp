@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace mbot::planning {
 namespace {
 
@@ -105,6 +107,40 @@ TEST(FrontiersTest, GoalSeesTheFrontierRatherThanStandingBehindAWall) {
   ASSERT_EQ(goals.size(), 1u);
   EXPECT_LT(goals[0].target.x, 0.3) << "goal at " << goals[0].target.x << ", " << goals[0].target.y;
   EXPECT_LT(goals[0].target.y, 0.9);
+}
+
+// A viewpoint from which a frontier was seen not to resolve is not chosen again for that frontier:
+// its goal moves at least the avoid radius away (the second viewpoint the explorer tries); another
+// frontier's goal is not affected.
+TEST(FrontiersTest, AFailedViewpointIsAvoidedForItsFrontierOnly) {
+  // The room of GoalIsCentroidOrNearestReachableCell, open to unknown space on its right.
+  OccupancyGrid g(60, 40, 0.05, 0, 0, 0);
+  for (int y = 1; y < 39; ++y) {
+    for (int x = 1; x < 40; ++x) g.at(x, y) = -100;
+  }
+  for (int x = 0; x < 41; ++x) g.at(x, 0) = g.at(x, 39) = 100;
+  for (int y = 0; y < 40; ++y) g.at(0, y) = 100;
+  const std::vector<Frontier> f = FindFrontiers(g, {5, 1.0});
+  ASSERT_EQ(f.size(), 1u);
+  AStarPlanner planner;
+  planner.SetMap(ObstacleDistanceGrid(g, {true, 0}));
+  const std::vector<FrontierGoal> first = RankFrontierGoals(f, {0.5, 1.0, 0}, g, planner, 0.10, {5, 1.0});
+  ASSERT_EQ(first.size(), 1u);
+  AvoidViews avoid;
+  avoid.radius_m = 0.25;
+  avoid.views.push_back({f[0].centroid_x, f[0].centroid_y, first[0].target.x, first[0].target.y});
+  const std::vector<FrontierGoal> second =
+      RankFrontierGoals(f, {0.5, 1.0, 0}, g, planner, 0.10, {5, 1.0}, nullptr, avoid);
+  ASSERT_EQ(second.size(), 1u);
+  EXPECT_GE(std::hypot(second[0].target.x - first[0].target.x, second[0].target.y - first[0].target.y), 0.25);
+  // A failed view recorded for a frontier elsewhere (its centroid beyond match_m) changes nothing.
+  AvoidViews elsewhere = avoid;
+  elsewhere.views[0].frontier_x -= 1.0;
+  const std::vector<FrontierGoal> same =
+      RankFrontierGoals(f, {0.5, 1.0, 0}, g, planner, 0.10, {5, 1.0}, nullptr, elsewhere);
+  ASSERT_EQ(same.size(), 1u);
+  EXPECT_DOUBLE_EQ(same[0].target.x, first[0].target.x);
+  EXPECT_DOUBLE_EQ(same[0].target.y, first[0].target.y);
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 #!/bin/bash
 # The `mazes` label: config/sweep_mazes.ini over generated mazes MBOT_MAZE_FIRST..MBOT_MAZE_LAST
 # (default 1-100), seed 1, under GNU parallel on every core, merged (config/merge_sweep.ini); every
-# maze must be completed without a collision. The table: <out>/sweep.md (BENCHMARKS.md).
+# maze must be within every bound (completed, no collision, coverage >= 99 %, walls >= 95 %, home
+# within 0.05 m). The table: <out>/sweep.md (BENCHMARKS.md).
 #   tests/sweep/maze_sweep.sh <mbot_nav> <source dir> <out dir>
 set -uo pipefail
 bin=$1 src=$2 out=$3
@@ -28,5 +29,5 @@ within = [r for r in ok if r['score.completed'] == '1' and r['score.collisions']
 outside = [r['maze'] for r in rows if r not in within]
 print('%d mazes; within every bound: %d (outside: %s)' % (len(rows), len(within), ', '.join(outside) or 'none'))
 print('%d mazes; not completed, failed or with a collision: %s' % (len(rows), ', '.join(bad) or 'none'))
-sys.exit(1 if bad else 0)
+sys.exit(1 if bad or outside else 0)
 PY

@@ -88,6 +88,9 @@ SensorModelOptions ParseSensorModelOptions(config::Section& s, const SensorModel
   sm.odds_scale = s.GetDouble("odds_scale", sm.odds_scale, "simplified field: log-likelihood per log-odds unit", 0.0);
   sm.neighbour_weight = s.GetDouble("neighbour_weight", sm.neighbour_weight,
                                     "simplified field: weight of the cell before/after", 0.0, 1.0);
+  sm.occupied_threshold = static_cast<int>(
+      s.GetInt("sensor_occupied_threshold", sm.occupied_threshold,
+               "cells with log-odds above this are the obstacles the sensor model measures distances to", -127, 126));
   sm.inlier_distance_m = s.GetDouble("inlier_distance_m", sm.inlier_distance_m,
                                      "a ray fits the map when it ends this close to an obstacle", 0.0);
 

@@ -35,7 +35,10 @@ Explorer::Explorer(const ExplorationOptions& options)
     : options_(options),
       distances_(options.distance),
       planner_(options.astar),
-      home_retries_left_(options.home_retries) {}
+      home_retries_left_(options.home_retries) {
+  failed_views_.radius_m = options.second_view_m;
+  failed_views_.match_m = options.frontier_match_m;
+}
 
 bool Explorer::IsBlacklisted(const Frontier& f, double t_s, bool* for_good) const {
   bool found = false;
@@ -95,7 +98,7 @@ bool Explorer::SelectFrontier(const mapping::OccupancyGrid& map, const motion::P
   std::vector<int> unreachable;
   const double r = options_.astar.robot_radius_m;
   const std::vector<FrontierGoal> goals =
-      RankFrontierGoals(frontiers_, pose, map, planner_, r, options_.frontier, &unreachable);
+      RankFrontierGoals(frontiers_, pose, map, planner_, r, options_.frontier, &unreachable, failed_views_);
   for (int i : unreachable) {
     blacklist_.push_back(
         {frontiers_[i].centroid_x, frontiers_[i].centroid_y, t_s + options_.blacklist_s, frontiers_[i].size()});
@@ -108,6 +111,7 @@ bool Explorer::SelectFrontier(const mapping::OccupancyGrid& map, const motion::P
       continue;
     }
     path_ = plan.path;
+    target_point_ = g.target;
     target_frontier_ = motion::Pose2D{f.centroid_x, f.centroid_y, 0.0};
     target_size_ = f.size();
     ++replans_;
@@ -209,12 +213,23 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
         reached_at_s_ = t_s;  // give the map time to show what the robot sees from here
       } else if (reached && t_s - reached_at_s_ >= options_.resolve_wait_s) {
         // Standing at the target and the frontier is still there: nothing more can be seen from
-        // here (unknown space the sensor cannot resolve, a gap too narrow to pass). Waiting longer
-        // will not change that, so it is ignored for good, unlike a frontier that was only unreachable.
-        blacklist_.push_back(
-            {target_frontier_->x, target_frontier_->y, std::numeric_limits<double>::infinity(), target_size_});
+        // here (unknown space the sensor cannot resolve, a gap too narrow to pass, a pocket behind a
+        // wall's end). It gets one more viewpoint away from this one; still there after that, it is
+        // ignored for good, unlike a frontier that was only unreachable.
+        std::vector<FailedView>& views = failed_views_.views;
+        const bool tried = std::any_of(views.begin(), views.end(), [&](const FailedView& v) {
+          return std::hypot(v.frontier_x - match->centroid_x, v.frontier_y - match->centroid_y) <=
+                 options_.frontier_match_m;
+        });
+        if (!tried && options_.second_view_m > 0) {
+          views.push_back({match->centroid_x, match->centroid_y, target_point_.x, target_point_.y});
+          why = "frontier unresolved at its target, trying another viewpoint";
+        } else {
+          blacklist_.push_back(
+              {target_frontier_->x, target_frontier_->y, std::numeric_limits<double>::infinity(), target_size_});
+          why = "frontier unresolved at its target, blacklisted";
+        }
         need = true;
-        why = "frontier unresolved at its target, blacklisted";
       }
     }
     if (!need && !PathIsSafe(pose)) {

@@ -94,7 +94,7 @@ FrontierLayers ComputeFrontierLayers(const mapping::OccupancyGrid& map, const Fr
 std::vector<FrontierGoal> RankFrontierGoals(const std::vector<Frontier>& frontiers, const motion::Pose2D& robot,
                                             const mapping::OccupancyGrid& map, AStarPlanner& planner,
                                             double clearance_m, const FrontierOptions& options,
-                                            std::vector<int>* unreachable) {
+                                            std::vector<int>* unreachable, const AvoidViews& avoid) {
   std::vector<FrontierGoal> goals;
   if (unreachable) unreachable->clear();
   if (frontiers.empty()) return goals;
@@ -113,12 +113,22 @@ std::vector<FrontierGoal> RankFrontierGoals(const std::vector<Frontier>& frontie
   std::vector<int> ring_of(cells.size(), -1), ring, next;
   for (int i = 0; i < static_cast<int>(frontiers.size()); ++i) {
     const Frontier& f = frontiers[i];
+    std::vector<const FailedView*> avoided_views;  // this frontier's
+    for (const FailedView& v : avoid.views)
+      if (std::hypot(v.frontier_x - f.centroid_x, v.frontier_y - f.centroid_y) <= avoid.match_m)
+        avoided_views.push_back(&v);
     ring.assign(f.cells.begin(), f.cells.end());
     for (int c : ring) ring_of[c] = i;
     int best = -1;
     for (int r = 0; r <= radius_cells && !ring.empty() && best < 0; ++r) {
       for (int c : ring) {
-        if (std::isfinite(cost[c]) && (best < 0 || cost[c] < cost[best])) best = c;
+        if (!std::isfinite(cost[c]) || (best >= 0 && cost[c] >= cost[best])) continue;
+        double x, y;
+        map.CellToWorld(c % w, c / w, &x, &y);
+        const bool avoided = std::any_of(avoided_views.begin(), avoided_views.end(), [&](const FailedView* v) {
+          return std::hypot(v->view_x - x, v->view_y - y) < avoid.radius_m;
+        });
+        if (!avoided) best = c;
       }
       next.clear();
       for (int c : ring) {

@@ -93,7 +93,13 @@ ExplorationOptions ParseExplorationOptions(config::Section& s, const Exploration
                                    "a frontier target counts as reached this close [m]", 0.0, 10.0);
   o.resolve_wait_s =
       s.GetDouble("resolve_wait_s", d.resolve_wait_s,
-                  "a frontier still there this long after its target was reached is ignored for good [s]", 0.0, 600.0);
+                  "a frontier still there this long after its target was reached is tried from another viewpoint, "
+                  "then ignored for good [s]",
+                  0.0, 600.0);
+  o.second_view_m = s.GetDouble("second_view_m", d.second_view_m,
+                                "a frontier unresolved at its target is tried once more from a viewpoint at least "
+                                "this far from the first (0: given up at once) [m]",
+                                0.0, 10.0);
   o.blacklist_s = s.GetDouble("blacklist_s", d.blacklist_s,
                               "how long an unreachable or unresolvable frontier is ignored [s]", 0.0, 1e6);
   o.blacklist_radius_m =

@@ -32,6 +32,9 @@ struct ExplorationOptions {
                                      // resolve_wait_s after its target was reached is ignored for good)
   double blacklist_radius_m = 0.30;  // frontiers whose centroid lies this close to a blacklisted one
   double frontier_match_m = 0.50;    // the target frontier still exists if a frontier centroid is this close
+  // A frontier still there at its target is tried once more from another viewpoint, at least this
+  // far from the first (the first may look at it past a wall's end); then it is given up for good.
+  double second_view_m = 0.25;
   // At home with frontiers left that can be reached and were given up only for a while (no path
   // then), the explorer forgets those and explores again, at most this many times.
   int home_retries = 2;
@@ -97,6 +100,8 @@ class Explorer {
   int target_size_ = 0;                            // its size in cells when it was chosen
   double reached_at_s_ = -1;                       // when the robot reached the target of the frontier being explored
   std::vector<Blacklisted> blacklist_;
+  motion::Pose2D target_point_;  // the viewpoint the robot was sent to
+  AvoidViews failed_views_;      // viewpoints from which a frontier did not resolve
   std::vector<Frontier> frontiers_;
   std::vector<FrontierLeft> left_;
   std::string failure_reason_;

@@ -53,9 +53,18 @@ struct FrontierGoal {
 // (no occupied cell on the line between; the nearest reachable cell when none does). Costs come
 // from one Dijkstra search from `robot` at `clearance_m`. Returns the goals sorted by cost, and in
 // `unreachable` the indices of frontiers with no reachable cell.
+// A viewpoint from which a frontier was seen not to resolve: a frontier whose centroid lies within
+// `match_m` of (frontier_x, frontier_y) gets no goal within `radius_m` of (view_x, view_y).
+struct FailedView {
+  double frontier_x = 0, frontier_y = 0, view_x = 0, view_y = 0;
+};
+struct AvoidViews {
+  std::vector<FailedView> views;
+  double radius_m = 0.25, match_m = 0.5;
+};
 std::vector<FrontierGoal> RankFrontierGoals(const std::vector<Frontier>& frontiers, const motion::Pose2D& robot,
                                             const mapping::OccupancyGrid& map, AStarPlanner& planner,
                                             double clearance_m, const FrontierOptions& options,
-                                            std::vector<int>* unreachable = nullptr);
+                                            std::vector<int>* unreachable = nullptr, const AvoidViews& avoid = {});
 
 }  // namespace mbot::planning
