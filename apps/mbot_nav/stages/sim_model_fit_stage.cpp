@@ -4,6 +4,8 @@
 // simulator's [source]), sim_model_fit_series.csv and plots of the wheel speeds and the yaw rate.
 #include <cmath>
 #include <optional>
+#include <stdexcept>
+#include <string>
 
 #include "mbot/common/atomic_file.hpp"
 #include "mbot/common/config.hpp"
@@ -42,11 +44,18 @@ class SimModelFitStage : public Stage {
     const std::string dir = ctx.output_dir + "/";
     const sim::SensorNoiseEstimate noise = sim::EstimateSensorNoise(log_, base_, fit_.min_standstill_s);
     std::optional<sim::SimModelFitResult> fit;
-    if (sim::WheelsTurned(log_))
-      fit = sim::FitSimModel(log_, base_, fit_);
-    else
+    if (sim::WheelsTurned(log_)) {
+      try {
+        fit = sim::FitSimModel(log_, base_, fit_);
+      } catch (const std::runtime_error& e) {
+        // The sensors' noise is still written; the run fails after it, naming why.
+        fit_error_ = e.what();
+      }
+    } else {
       mbot::log::Info("fit_sim_model: the robot stood still throughout: its sensors' noise only, no motor fit");
+    }
     reports::Json j = {{"source", ctx.source_path}, {"interrupted", interrupted}};
+    if (!fit_error_.empty()) j["fit_error"] = fit_error_;
     j["noise"] = {{"gyro_samples", noise.gyro_samples},
                   {"gyro_bias_rad_s", Number(noise.gyro_bias_rad_s)},
                   {"gyro_noise_rad_s", Number(noise.gyro_noise_rad_s)},
@@ -93,6 +102,7 @@ class SimModelFitStage : public Stage {
     reports::WriteJson(dir + "sim_model_fit.json", j);
     WriteFileAtomically(dir + "sim_model.ini", [&](std::ostream& out) { out << ini; });
     mbot::log::Info("fit_sim_model: outputs in " + ctx.output_dir);
+    if (!fit_error_.empty()) throw std::runtime_error(fit_error_ + " (the sensors' noise is written)");
   }
 
  private:
@@ -138,6 +148,7 @@ class SimModelFitStage : public Stage {
   sim::SimFidelityOptions base_;
   sim::SimModelFitOptions fit_;
   std::vector<msgs::Event> log_;
+  std::string fit_error_;
 };
 
 }  // namespace

@@ -37,7 +37,13 @@ Explorer::Explorer(const ExplorationOptions& options)
       planner_(options.astar),
       home_retries_left_(options.home_retries) {
   failed_views_.radius_m = options.second_view_m;
-  failed_views_.match_m = options.frontier_match_m;
+  failed_views_.match_m = options.blacklist_radius_m;  // the same frontier as the blacklist's
+}
+
+bool Explorer::HadFailedView(const Frontier& f) const {
+  return std::any_of(failed_views_.views.begin(), failed_views_.views.end(), [&](const FailedView& v) {
+    return std::hypot(v.frontier_x - f.centroid_x, v.frontier_y - f.centroid_y) <= failed_views_.match_m;
+  });
 }
 
 bool Explorer::IsBlacklisted(const Frontier& f, double t_s, bool* for_good) const {
@@ -100,8 +106,12 @@ bool Explorer::SelectFrontier(const mapping::OccupancyGrid& map, const motion::P
   const std::vector<FrontierGoal> goals =
       RankFrontierGoals(frontiers_, pose, map, planner_, r, options_.frontier, &unreachable, failed_views_);
   for (int i : unreachable) {
-    blacklist_.push_back(
-        {frontiers_[i].centroid_x, frontiers_[i].centroid_y, t_s + options_.blacklist_s, frontiers_[i].size()});
+    // One whose only reachable cells were seen not to resolve it (a failed viewpoint) is given up for
+    // good; one with no path now, for a while.
+    const bool viewed = HadFailedView(frontiers_[i]);
+    blacklist_.push_back({frontiers_[i].centroid_x, frontiers_[i].centroid_y,
+                          viewed ? std::numeric_limits<double>::infinity() : t_s + options_.blacklist_s,
+                          frontiers_[i].size()});
   }
   for (const FrontierGoal& g : goals) {
     const Frontier& f = frontiers_[g.frontier];
@@ -130,7 +140,8 @@ std::vector<FrontierLeft> Explorer::FrontiersLeft(const mapping::OccupancyGrid& 
                                                   double t_s) {
   const std::vector<Frontier> all = FindFrontiers(map, options_.frontier);
   std::vector<int> unreachable;
-  RankFrontierGoals(all, pose, map, planner_, options_.astar.robot_radius_m, options_.frontier, &unreachable);
+  RankFrontierGoals(all, pose, map, planner_, options_.astar.robot_radius_m, options_.frontier, &unreachable,
+                    failed_views_);
   std::vector<FrontierLeft> left;
   for (int i = 0; i < static_cast<int>(all.size()); ++i) {
     const bool reachable = std::find(unreachable.begin(), unreachable.end(), i) == unreachable.end();
@@ -216,13 +227,8 @@ ExplorationUpdate Explorer::Update(const mapping::OccupancyGrid& map, const moti
         // here (unknown space the sensor cannot resolve, a gap too narrow to pass, a pocket behind a
         // wall's end). It gets one more viewpoint away from this one; still there after that, it is
         // ignored for good, unlike a frontier that was only unreachable.
-        std::vector<FailedView>& views = failed_views_.views;
-        const bool tried = std::any_of(views.begin(), views.end(), [&](const FailedView& v) {
-          return std::hypot(v.frontier_x - match->centroid_x, v.frontier_y - match->centroid_y) <=
-                 options_.frontier_match_m;
-        });
-        if (!tried && options_.second_view_m > 0) {
-          views.push_back({match->centroid_x, match->centroid_y, target_point_.x, target_point_.y});
+        if (!HadFailedView(*match) && options_.second_view_m > 0) {
+          failed_views_.views.push_back({match->centroid_x, match->centroid_y, target_point_.x, target_point_.y});
           why = "frontier unresolved at its target, trying another viewpoint";
         } else {
           blacklist_.push_back(

@@ -72,8 +72,8 @@ std::vector<double> Residuals(const SimFidelityResult& r, double base_radius_m) 
 // residual blocks (Ceres evaluates them one by one at the same points).
 class Simulations {
  public:
-  Simulations(const std::vector<Event>& log, SimFidelityOptions base, double split_s)
-      : log_(log), base_(std::move(base)), split_s_(split_s) {}
+  Simulations(const std::vector<Event>& log, SimFidelityOptions base, double split_s, int size)
+      : log_(log), base_(std::move(base)), split_s_(split_s), size_(size) {}
 
   const std::vector<double>& At(const double* x) {
     std::array<double, kParameters> key;
@@ -83,9 +83,9 @@ class Simulations {
     SimFidelityOptions o = base_;
     o.robot = Apply(o.robot, x);
     std::vector<double> r = Residuals(Compare(log_, o, 0.0, split_s_), o.robot.geometry.base_radius_m);
-    if (size_ >= 0 && static_cast<int>(r.size()) != size_)
-      throw std::logic_error("sim_model_fit: the windows changed with the parameters");
-    size_ = static_cast<int>(r.size());
+    // The windows are the log's (its encoder and gyro times); a simulation that gives other ones
+    // (it cannot, short of a bug) is answered with no residuals, which Evaluate reports as a failure.
+    if (static_cast<int>(r.size()) != size_) r.clear();
     if (order_.size() >= 64) cache_.erase(order_.front()), order_.pop_front();
     order_.push_back(key);
     return cache_.emplace(key, std::move(r)).first->second;
@@ -95,7 +95,7 @@ class Simulations {
   const std::vector<Event>& log_;
   SimFidelityOptions base_;
   double split_s_;
-  int size_ = -1;
+  int size_;  // residuals per simulation: 2 per wheel window, 1 per gyro window
   std::map<std::array<double, kParameters>, std::vector<double>> cache_;
   std::deque<std::array<double, kParameters>> order_;
 };
@@ -111,6 +111,7 @@ class WindowCost : public ceres::CostFunction {
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
     const int n = num_residuals();
     const std::vector<double>& r = sims_->At(parameters[0]);
+    if (r.empty()) return false;
     std::copy(r.begin() + offset_, r.begin() + offset_ + n, residuals);
     if (jacobians == nullptr || jacobians[0] == nullptr) return true;
     std::array<double, kParameters> x;
@@ -119,9 +120,11 @@ class WindowCost : public ceres::CostFunction {
       const double keep = x[j];
       x[j] = keep + step_;
       const std::vector<double>& at_plus = sims_->At(x.data());
+      if (at_plus.empty()) return false;
       const std::vector<double> plus(at_plus.begin() + offset_, at_plus.begin() + offset_ + n);
       x[j] = keep - step_;
       const std::vector<double>& minus = sims_->At(x.data());
+      if (minus.empty()) return false;
       for (int i = 0; i < n; ++i)
         jacobians[0][i * kParameters + j] =
             (plus[static_cast<size_t>(i)] - minus[static_cast<size_t>(offset_ + i)]) / (2 * step_);
@@ -229,7 +232,8 @@ SensorNoiseEstimate EstimateSensorNoise(const std::vector<Event>& log, const Sim
     } else if (e.kind == EventKind::kLidar) {
       const auto& s = std::get<msgs::LidarScan>(e.payload);
       const int k = in_still(t, 0.0);
-      const bool whole = k >= 0 && in_still(t - 0.25, 0.0) == k;  // the whole revolution stood
+      const double period_s = 1.0 / o.robot.lidar.rate_hz;
+      const bool whole = k >= 0 && in_still(t - period_s, 0.0) == k;  // the whole revolution stood
       n.scans += whole;
       for (size_t i = 0; i < s.ranges_m.size() && i < s.angles_rad.size(); ++i) {
         const double r = s.ranges_m[i];
@@ -296,10 +300,10 @@ SimModelFitResult FitSimModel(const std::vector<Event>& log, const SimFidelityOp
                              " s: nothing to hold out");
 
   std::array<double, kParameters> x = Read(quiet.robot);
-  Simulations sims(log, quiet, out.split_s);
-  ceres::Problem problem;
   const int wheel = static_cast<int>(out.fit_before.wheel_windows.size());
   const int yaw = static_cast<int>(out.fit_before.yaw_windows.size());
+  Simulations sims(log, quiet, out.split_s, 2 * wheel + yaw);
+  ceres::Problem problem;
   for (int k = 0; k < wheel; ++k)
     problem.AddResidualBlock(new WindowCost(&sims, 2 * k, 2, options.numeric_step),
                              new ceres::HuberLoss(options.huber_m_s), x.data());

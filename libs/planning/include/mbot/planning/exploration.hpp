@@ -84,7 +84,8 @@ class Explorer {
     int cells;  // the frontier's size when it was given up
   };
   bool IsBlacklisted(const Frontier& f, double t_s, bool* for_good = nullptr) const;
-  void DropBlacklisted(double t_s);  // from frontiers_
+  bool HadFailedView(const Frontier& f) const;  // a viewpoint already failed to resolve it
+  void DropBlacklisted(double t_s);             // from frontiers_
   bool PathIsSafe(const motion::Pose2D& pose) const;
   bool SelectFrontier(const mapping::OccupancyGrid& map, const motion::Pose2D& pose, double t_s, ExplorationUpdate* u);
   void Fail(const std::string& reason, ExplorationUpdate* u);

@@ -48,11 +48,6 @@ struct FrontierGoal {
   double cost = 0.0;      // path cost from the robot (planner cost model)
 };
 
-// For each frontier, the cell the robot can reach: its centroid when that cell is reachable,
-// otherwise the reachable cell nearest the centroid within options.search_radius_m that sees it
-// (no occupied cell on the line between; the nearest reachable cell when none does). Costs come
-// from one Dijkstra search from `robot` at `clearance_m`. Returns the goals sorted by cost, and in
-// `unreachable` the indices of frontiers with no reachable cell.
 // A viewpoint from which a frontier was seen not to resolve: a frontier whose centroid lies within
 // `match_m` of (frontier_x, frontier_y) gets no goal within `radius_m` of (view_x, view_y).
 struct FailedView {
@@ -62,6 +57,13 @@ struct AvoidViews {
   std::vector<FailedView> views;
   double radius_m = 0.25, match_m = 0.5;
 };
+
+// For each frontier, the cell the robot can reach: its centroid when that cell is reachable,
+// otherwise the reachable cell nearest the centroid within options.search_radius_m that sees it
+// (no occupied cell on the line between; the nearest reachable cell when none does). Costs come
+// from one Dijkstra search from `robot` at `clearance_m`. Returns the goals sorted by cost, and in
+// `unreachable` the indices of frontiers with no reachable cell; a frontier's goal avoids the failed
+// viewpoints `avoid` holds for it.
 std::vector<FrontierGoal> RankFrontierGoals(const std::vector<Frontier>& frontiers, const motion::Pose2D& robot,
                                             const mapping::OccupancyGrid& map, AStarPlanner& planner,
                                             double clearance_m, const FrontierOptions& options,

@@ -39,9 +39,10 @@ struct SimFidelityOptions {
   motion::Pose2D lidar_mount;
   double residual_histogram_bin_m = 0.01;  // the residual histogram's bins, over ±histogram_range_m
   double residual_histogram_range_m = 0.3;
-  // The part of the log compared, in seconds from its first motion-capture pose: the simulated robot
-  // starts at the first truth pose at or after begin_s (at rest), and events after end_s are not
-  // taken (a fit on one part of a log, held out on the rest).
+  // The part of the log compared, in seconds from its first motion-capture pose. The simulated robot
+  // always starts at the first truth pose, at rest, driven by every command; at begin_s (> 0) it is
+  // re-placed at the truth pose there, moving as it was, and compared from then on. Events after
+  // end_s are not taken (a fit on one part of a log, held out on the rest).
   double begin_s = 0.0;
   double end_s = 1e300;
 };

@@ -94,6 +94,7 @@ struct SimRobotOptions {
   // commands, encoders and gyro (fit_sim_model.ini, sweep_drive_square's first half; BENCHMARKS.md).
   double left_motor_gain = 1.119;  // per-wheel differences: true speed scale
   double right_motor_gain = 1.121;
+  // The motors' own lag fits to its 1 ms floor: the data show none beside the firmware's filters.
   double motor_time_constant_s = 0.0011;                         // wheel speed follows its steady state with this lag
   motion::MotorCalibration firmware_calibration;                 // what the firmware's feed-forward believes
   motion::WheelControllerOptions controller = FittedFirmware();  // its dt is the firmware period
