@@ -108,6 +108,8 @@ MissionReport Mission::Report() const {
   r.commands = commands_, r.paths = paths_, r.stale_pose_stops = stale_stops_;
   r.corrections = total_corrections_, r.stall_recoveries = recoveries_, r.bumps = bumps_marked_;
   r.odometry_restarts = continuity_.restarts();
+  r.odometry_outliers = continuity_.outliers(), r.odometry_duplicates = continuity_.duplicates();
+  r.last_command = last_sent_;
   r.rounds = rounds_ + 1;
   task_->AddToReport(&r);
   return r;
@@ -359,6 +361,7 @@ bool Mission::ManualStep(const Pose2D& pose, double dt) {
 
 void Mission::Send(double v, double w) {
   ++commands_;
+  last_sent_ = {v, w};
   if (out_) out_->emplace_back(std::in_place_type<motion::VelocityCommand>, motion::VelocityCommand{v, w});
 }
 

@@ -15,6 +15,9 @@ Json MissionJson(const mission::MissionReport& r, bool interrupted, bool frontie
   j["stall_recoveries"] = r.stall_recoveries;
   j["bumps"] = r.bumps;
   j["odometry_restarts"] = r.odometry_restarts;
+  j["odometry_outliers"] = r.odometry_outliers;
+  j["odometry_duplicates"] = r.odometry_duplicates;
+  j["last_command"] = {{"v_m_s", r.last_command.v_m_s}, {"w_rad_s", r.last_command.w_rad_s}};
   j["rounds"] = r.rounds;
   if (r.task == mission::TaskKind::kWarehouse) {
     j["stops"] = r.stops;

@@ -131,7 +131,11 @@ struct MissionReport {
   int corrections = 0, stall_recoveries = 0;
   int bumps = 0;              // obstacles marked where the robot stalled
   int odometry_restarts = 0;  // the robot's odometry started again from zero (a firmware restart)
-  int rounds = 1;             // rounds of the task run (repeat + 1 when all completed)
+  // Odometry messages the continuity check did not take (a corrupt one; a jump's duplicate), and the
+  // last command sent: what a run that ended stopped short of its goal is read by.
+  int odometry_outliers = 0, odometry_duplicates = 0;
+  motion::VelocityCommand last_command;
+  int rounds = 1;  // rounds of the task run (repeat + 1 when all completed)
   // explore: the frontiers left on the map at home (none when completed).
   std::vector<planning::FrontierLeft> frontiers_left;
   // warehouse: stops in all, and done by the mission's own estimate.
@@ -237,6 +241,7 @@ class Mission {
   long long commands_ = 0, paths_ = 0, stale_stops_ = 0;
   int corrections_ = 0, total_corrections_ = 0, recoveries_ = 0, stalls_this_goal_ = 0, bumps_marked_ = 0;
   motion::VelocityCommand last_command_;
+  motion::VelocityCommand last_sent_;  // the last command sent, whatever sent it (the report's)
   bool ManualStep(const motion::Pose2D& pose, double dt);
   bool watched_ = false;
   bool manual_ = false;                        // a person took over
