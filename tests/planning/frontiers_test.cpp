@@ -53,14 +53,20 @@ TEST(FrontiersTest, OccupiedCellsAreNeverFrontiers) {
   EXPECT_TRUE(FindFrontiers(g, {1, 1.0}).empty());
 }
 
-TEST(FrontiersTest, GoalIsCentroidOrNearestReachableCell) {
-  // A free room whose right side opens to unknown space; a wall segment sits on the frontier's centroid.
+// A free 2 m x 1.9 m room whose right side opens to unknown space.
+OccupancyGrid RoomOpenToTheRight() {
   OccupancyGrid g(60, 40, 0.05, 0, 0, 0);
   for (int y = 1; y < 39; ++y) {
     for (int x = 1; x < 40; ++x) g.at(x, y) = -100;
   }
   for (int x = 0; x < 41; ++x) g.at(x, 0) = g.at(x, 39) = 100;
   for (int y = 0; y < 40; ++y) g.at(0, y) = 100;
+  return g;
+}
+
+TEST(FrontiersTest, GoalIsCentroidOrNearestReachableCell) {
+  // A free room whose right side opens to unknown space; a wall segment sits on the frontier's centroid.
+  const OccupancyGrid g = RoomOpenToTheRight();
   const std::vector<Frontier> f = FindFrontiers(g, {5, 1.0});
   ASSERT_EQ(f.size(), 1u);
   AStarPlanner planner;
@@ -113,13 +119,7 @@ TEST(FrontiersTest, GoalSeesTheFrontierRatherThanStandingBehindAWall) {
 // its goal moves at least the avoid radius away (the second viewpoint the explorer tries); another
 // frontier's goal is not affected.
 TEST(FrontiersTest, AFailedViewpointIsAvoidedForItsFrontierOnly) {
-  // The room of GoalIsCentroidOrNearestReachableCell, open to unknown space on its right.
-  OccupancyGrid g(60, 40, 0.05, 0, 0, 0);
-  for (int y = 1; y < 39; ++y) {
-    for (int x = 1; x < 40; ++x) g.at(x, y) = -100;
-  }
-  for (int x = 0; x < 41; ++x) g.at(x, 0) = g.at(x, 39) = 100;
-  for (int y = 0; y < 40; ++y) g.at(0, y) = 100;
+  const OccupancyGrid g = RoomOpenToTheRight();
   const std::vector<Frontier> f = FindFrontiers(g, {5, 1.0});
   ASSERT_EQ(f.size(), 1u);
   AStarPlanner planner;

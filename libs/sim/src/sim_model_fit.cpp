@@ -344,7 +344,6 @@ SimModelFitResult FitSimModel(const std::vector<Event>& log, const SimFidelityOp
   fitted.robot = Quiet(out.fitted);
   out.fit_after = Compare(log, fitted, 0.0, out.split_s);
   out.held_after = Compare(log, fitted, out.split_s, 1e300);
-  out.noise = EstimateSensorNoise(log, base, options.min_standstill_s);
   return out;
 }
 

@@ -55,8 +55,7 @@ struct SimModelFitResult {
   std::vector<FittedParameter> parameters;
   SimRobotOptions fitted;  // the base model with the fitted values
   // The comparison (noise off, as fitted) before and after, on the fitted and on the held-out part.
-  SimFidelityResult fit_before, fit_after, held_before, held_after;
-  SensorNoiseEstimate noise;
+  SimFidelityResult fit_before, fit_after, held_before, held_after;  // the sensors: EstimateSensorNoise
 };
 
 // Whether the log's encoders counted at all (a log where the robot stood fits no motor).
