@@ -8,6 +8,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -336,11 +337,14 @@ TEST(GraphSlamRegression, AcesFirstFiveMinutesBelowCartographer) {
 // log's pose; its robot pose is that pose with the mount taken off (robot = laser ∘ mount⁻¹), so the
 // robot's odometry is what a robot carrying the laser there would have read.
 std::string AcesAsRobotLaser(int lines, const msgs::Pose2D& laser = {}, const std::string& name = "aces_robotlaser") {
+  // Each caller names its own file, and it appears whole (renamed into place): ctest runs the tests
+  // that share this helper at the same time.
   const std::string out = ::testing::TempDir() + "/" + name + ".log";
+  const std::string partial = out + ".partial";
   auto c = config::Config::FromString("[source]\ntype = auto\npath = " + Data("carmen/aces-raw.clf.gz") + "\n");
   config::Section s = c.GetSection("source");
   auto source = msgs::OpenSource(msgs::ParseSourceOptions(s));
-  std::ofstream o(out);
+  std::ofstream o(partial);
   o.precision(17);
   int written = 0;
   std::optional<msgs::LidarScan> scan;
@@ -361,6 +365,8 @@ std::string AcesAsRobotLaser(int lines, const msgs::Pose2D& laser = {}, const st
     scan.reset();
     if (++written >= lines) break;
   }
+  o.close();
+  std::filesystem::rename(partial, out);
   return out;
 }
 
@@ -420,7 +426,7 @@ std::string RelationsOfTheRobot(const std::string& relations, const msgs::Pose2D
 // 0.0418 m); taking the mount as the centre gives 0.092 m.
 TEST(GraphSlamRegression, ALaserAwayFromTheRobotsCentreScoresAsACentredOne) {
   const int scans = 1500;
-  const std::string centred_log = AcesAsRobotLaser(scans);
+  const std::string centred_log = AcesAsRobotLaser(scans, {}, "aces_robotlaser_centred");
   const std::string centred =
       RunConfig("graph_slam.ini", "graph_slam_aces_centred",
                 AcesSets({"source.path=" + centred_log, "slam.graph_background=false"}), "metrics.json");
