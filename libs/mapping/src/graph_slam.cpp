@@ -63,6 +63,7 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
   Pose2D local = last_local_.Compose(last_odometry_.Inverse().Compose(odometry));
   auto points = std::make_shared<const std::vector<Point2>>(ScanHitPoints(rays, options_.point_spacing_m));
   ++stats_.scans;
+  if (odometry_doubtful) ++doubtful_seen_;
   const bool sparse = static_cast<int>(points->size()) < options_.min_points;
   if (sparse) {
     ++stats_.sparse_scans;
@@ -98,6 +99,7 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
           m = w;
           ++stats_.recoveries;
           odometry_doubtful_ = true;
+          ++doubtful_seen_;
         }
       }
       if (m.found) {
@@ -157,7 +159,12 @@ void GraphSlam::AddNode(const Pose2D& local, const Pose2D& odometry, std::shared
                         std::shared_ptr<const std::vector<Point2>> points) {
   const int index = static_cast<int>(nodes_.size());
   auto loop_points = std::make_shared<const std::vector<Point2>>(ScanHitPoints(*rays, options_.loop_point_spacing_m));
-  Node n{local, ToGlobal(local), odometry, std::move(rays), std::move(points), std::move(loop_points), {}};
+  Node n{local, ToGlobal(local), odometry, std::move(rays), std::move(points), std::move(loop_points), {},
+         0.0,   doubtful_seen_};
+  if (index > 0) {
+    const Node& last = nodes_.back();
+    n.path_m = last.path_m + std::hypot(local.x - last.local.x, local.y - last.local.y);
+  }
   if (active_.empty() || submaps_[active_.back()].nodes >= options_.nodes_per_submap) {
     Submap s;
     s.local = {local.x, local.y, 0.0};
@@ -175,6 +182,8 @@ void GraphSlam::AddNode(const Pose2D& local, const Pose2D& odometry, std::shared
     s.grid->Insert(*n.rays, local);
     s.dirty = true;
     ++s.nodes;
+    if (s.first_node < 0) s.first_node = index;
+    s.last_node = index;
     n.submaps.push_back(si);
     constraints_.push_back({PoseConstraint::kIntraSubmap, si, index, s.local.Inverse().Compose(local),
                             options_.local_translation_weight, options_.local_rotation_weight, 0.0});
@@ -228,7 +237,30 @@ void GraphSlam::QueueSearches(int node, int submap) {
   if (std::find(n.submaps.begin(), n.submaps.end(), submap) != n.submaps.end()) return;
   const Submap& s = submaps_[submap];
   if (std::hypot(n.global.x - s.global.x, n.global.y - s.global.y) > options_.loop_max_distance_m) return;
-  pending_.push_back({node, submap});
+  const SearchWindow w = LoopWindow(n, s);
+  if (w.linear_m < options_.loop_window.linear_m || w.angular_rad < options_.loop_window.angular_rad) {
+    ++stats_.loop_searches_bounded;
+  }
+  pending_.push_back({node, submap, w});
+}
+
+SearchWindow LoopSearchWindow(const GraphSlamOptions& o, double path_m, bool doubtful) {
+  SearchWindow w = o.loop_window;
+  if (doubtful) return w;
+  if (o.loop_drift_m_per_m > 0) {
+    w.linear_m = std::min(w.linear_m, o.local_window.linear_m + o.loop_drift_m_per_m * path_m);
+  }
+  if (o.loop_drift_rad_per_m > 0) {
+    w.angular_rad = std::min(w.angular_rad, o.local_window.angular_rad + o.loop_drift_rad_per_m * path_m);
+  }
+  return w;
+}
+
+SearchWindow GraphSlam::LoopWindow(const Node& n, const Submap& s) const {
+  // The path between the node and the nearer end of the submap's nodes, and whether the front end
+  // recovered or doubted its odometry anywhere on it.
+  const Node& near = nodes_[n.path_m >= nodes_[s.last_node].path_m ? s.last_node : s.first_node];
+  return LoopSearchWindow(options_, std::abs(n.path_m - near.path_m), n.doubtful != near.doubtful);
 }
 
 std::unique_ptr<GraphSlam::Job> GraphSlam::MakeJob(int iterations, bool render) {
@@ -261,7 +293,7 @@ void GraphSlam::RunJob(Job* job) const {
     const Pose2D guess = origin.Compose(job->submaps[q.submap].Inverse().Compose(job->nodes[q.node]));
     const MatchGrid& field = job->search_fields[i]->Get();
     const MatchResult m =
-        MatchBranchAndBound(field, *job->search_loop_points[i], guess, options_.loop_window, options_.loop_min_score);
+        MatchBranchAndBound(field, *job->search_loop_points[i], guess, q.window, options_.loop_min_score);
     ++job->searched;
     if (!m.found) continue;
     const Pose2D refined = RefineMatch(field, *job->search_points[i], m.pose, options_.refine);

@@ -217,6 +217,14 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
   g.loop_min_score = num("loop_min_score", g.loop_min_score, "a loop closure needs this match score (0..1)", 0.0, 1.0);
   g.loop_max_distance_m = num("loop_max_distance_m", g.loop_max_distance_m,
                               "search submaps whose origin lies this close to the node", 0.0, 1e6);
+  g.loop_drift_m_per_m = num("loop_drift_m_per_m", g.loop_drift_m_per_m,
+                             "loop search: the local window grows by this per metre of path between the submap and "
+                             "the node, up to loop_window_m (0: loop_window_m alone)",
+                             0.0, 10.0);
+  g.loop_drift_rad_per_m = num("loop_drift_rad_per_m", g.loop_drift_rad_per_m,
+                               "loop search: the local window's heading grows by this per metre of path, up to "
+                               "loop_window_rad (0: loop_window_rad alone)",
+                               0.0, 10.0);
   g.loop_every_nodes =
       count("loop_every_nodes", g.loop_every_nodes, "search loop closures for every k-th node", 1, 100000);
   g.loop_levels = count("loop_levels", g.loop_levels, "branch-and-bound levels of a finished submap", 1, 12);

@@ -68,14 +68,26 @@ struct GraphSlamOptions {
   SearchWindow loop_window{3.0, 0.35, 0.005};
   double loop_min_score = 0.55;
   double loop_max_distance_m = 10.0;  // node to submap origin, by the current estimate
-  int loop_every_nodes = 5;           // search every k-th node
-  int loop_levels = 8;                // branch-and-bound levels of a finished submap
+  // The front end's drift bounds a closure's correction: a node is searched in a finished submap
+  // over the local window grown by these rates times the path the front end drove between the
+  // submap's last node and the node (capped by loop_window). A look-alike place farther than the
+  // matched path can have drifted is never searched. A path with a recovery or doubtful odometry
+  // in it is unbounded (loop_window). 0: the loop window alone.
+  double loop_drift_m_per_m = 0.02;
+  double loop_drift_rad_per_m = 0.01;
+  int loop_every_nodes = 5;  // search every k-th node
+  int loop_levels = 8;       // branch-and-bound levels of a finished submap
   PoseGraphOptions graph{10.0, 50, 1};
   int final_iterations = 200;
   int optimize_every_nodes = 90;
   bool background = true;
   bool rerender_map = true;  // re-render the live map from the optimised poses after each solve
 };
+
+// The window a loop-closure search of a node in a finished submap covers, for `path_m` of the front
+// end's path between them (`doubtful`: a recovery or doubtful odometry on it): the local window
+// grown by the drift rates times the path, never beyond loop_window.
+SearchWindow LoopSearchWindow(const GraphSlamOptions& options, double path_m, bool doubtful);
 
 struct RejectedClosure {
   int node = 0, submap = 0;
@@ -88,6 +100,7 @@ struct GraphSlamStats {
   int doubtful_searches = 0;                  // of the searches: those the odometry's gap or restart asked for
   int degenerate_scans = 0;                   // whose motion along a corridor came from odometry
   int64_t loop_searches = 0, loop_closures = 0;
+  int64_t loop_searches_bounded = 0;      // of the searches: those the path's drift bound kept inside loop_window
   std::vector<RejectedClosure> rejected;  // by the robust loss, at the last solve
   int optimizations = 0;
   double optimize_s = 0, loop_search_s = 0, front_end_s = 0, render_s = 0;
@@ -131,6 +144,8 @@ class GraphSlam {
     std::shared_ptr<const std::vector<ScanRay>> rays;
     std::shared_ptr<const std::vector<Point2>> points, loop_points;
     std::vector<int> submaps;  // it was inserted into
+    double path_m = 0;         // the front end's path length from the first node
+    int doubtful = 0;          // recoveries and doubtful odometry steps before it (a running count)
   };
   // A finished submap's search field, built on its first search (on the worker when `background`),
   // so finishing a submap costs the front end only a crop of its grid.
@@ -156,9 +171,11 @@ class GraphSlam {
     bool dirty = true;
     bool finished = false;
     int nodes = 0;
+    int first_node = -1, last_node = -1;
   };
   struct Search {
     int node = 0, submap = 0;
+    SearchWindow window;
   };
   struct ScanAnchor {
     int node = 0;
@@ -188,6 +205,8 @@ class GraphSlam {
                std::shared_ptr<const std::vector<ScanRay>> rays, std::shared_ptr<const std::vector<Point2>> points);
   void FinishSubmap(int index);
   void QueueSearches(int node, int submap);
+  // The loop window for `node` in finished `submap` (LoopSearchWindow).
+  SearchWindow LoopWindow(const Node& node, const Submap& submap) const;
   std::unique_ptr<Job> MakeJob(int iterations, bool render);
   void RunJob(Job* job) const;
   void ApplyJob(Job* job);
@@ -207,6 +226,7 @@ class GraphSlam {
   double mean_score_ = 0;      // running mean of the front end's match scores
   int scores_ = 0;
   bool odometry_doubtful_ = false;  // a recovery since the last node
+  int doubtful_seen_ = 0;           // recoveries and doubtful odometry steps so far
   std::vector<Node> nodes_;
   std::vector<Submap> submaps_;
   std::vector<int> active_;  // submap indices, oldest first
