@@ -100,5 +100,31 @@ TEST(DeskewScan, ShortAndMissingReturnsClearNothingOrAreMisses) {
   EXPECT_LE(misses, 1);  // 6.0 m beyond max_range_m clears as a miss; too short and no return are dropped
 }
 
+// Range smoothing: along a wall 1 m ahead measured with ±2 cm of alternating noise, each return
+// becomes the mean of itself and its two neighbours (the noise falls to a third); at a step to a
+// wall 0.5 m behind, each side keeps its own range; a lost beam stays lost.
+TEST(DeskewScan, SmoothingAveragesASurfaceAndKeepsItsEdges) {
+  std::vector<float> ranges, angles;
+  for (int i = 0; i < 20; ++i) {
+    ranges.push_back((i < 10 ? 1.0f : 1.5f) + (i % 2 == 0 ? 0.02f : -0.02f));
+    angles.push_back(0.0f);
+  }
+  ranges[15] = NAN;
+  ScanOptions o;
+  o.smooth_beams = 1;
+  const std::vector<ScanRay> rays = DeskewScan(ranges, angles, {}, {}, {}, 0.0, o);
+  ASSERT_EQ(rays.size(), 19u);  // the lost beam is dropped, as without smoothing
+  for (size_t i = 1; i + 1 < rays.size(); ++i) {
+    const double r = rays[i].ex, expect = i < 10 ? 1.0 : 1.5;
+    if (i == 14 || i == 15) continue;     // next to the lost beam: one neighbour only
+    EXPECT_NEAR(r, expect, 0.0068) << i;  // (2 - 1) × 2 cm / 3 at most
+  }
+  // Either side of the edge: itself and its one neighbour on the same wall.
+  EXPECT_NEAR(rays[9].ex, (0.98 + 1.02) / 2, 1e-6);
+  EXPECT_NEAR(rays[10].ex, (1.52 + 1.48) / 2, 1e-6);
+  o.smooth_beams = 0;
+  EXPECT_NEAR(DeskewScan(ranges, angles, {}, {}, {}, 0.0, o)[1].ex, 0.98, 1e-6);
+}
+
 }  // namespace
 }  // namespace mbot::mapping

@@ -34,6 +34,11 @@ ScanOptions ParseScanOptions(config::Section& s, const ScanOptions& defaults) {
       s.GetDouble("max_range_m", o.max_range_m, "returns at or beyond this are misses (0: the sensor's maximum)", 0.0);
   o.no_return_clear_m = s.GetDouble("no_return_clear_m", o.no_return_clear_m,
                                     "a beam without return clears this far (0: not at all)", 0.0);
+  o.smooth_beams = static_cast<int>(s.GetInt(
+      "smooth_beams", o.smooth_beams,
+      "each return is the mean of those up to this many beams either side on the same surface (0: off)", 0, 50));
+  o.smooth_max_step_m = s.GetDouble("smooth_max_step_m", o.smooth_max_step_m,
+                                    "smoothing: neighbours within this of a return are on its surface", 0.0);
 
   return o;
 }

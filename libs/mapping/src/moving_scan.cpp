@@ -1,5 +1,6 @@
 #include "mbot/mapping/moving_scan.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace mbot::mapping {
@@ -12,8 +13,18 @@ std::vector<ScanRay> DeskewScan(const std::vector<float>& ranges, const std::vec
   std::vector<ScanRay> rays;
   rays.reserve(ranges.size());
   const motion::Pose2D identity;
-  for (size_t i = 0; i < ranges.size(); ++i) {
-    const double r = ranges[i];
+  const int n = static_cast<int>(ranges.size());
+  const auto valid = [&](int j) { return std::isfinite(ranges[j]) && ranges[j] >= options.min_range_m; };
+  for (int i = 0; i < n; ++i) {
+    double r = ranges[i];
+    if (options.smooth_beams > 0 && valid(i)) {
+      double sum = 0;
+      int used = 0;
+      for (int j = std::max(0, i - options.smooth_beams); j <= std::min(n - 1, i + options.smooth_beams); ++j) {
+        if (valid(j) && std::abs(ranges[j] - ranges[i]) <= options.smooth_max_step_m) sum += ranges[j], ++used;
+      }
+      r = sum / used;
+    }
     double length;
     bool hit;
     if (!std::isfinite(r) || r <= 0.0) {  // no return

@@ -20,6 +20,11 @@ struct ScanOptions {
   double min_range_m = 0.10;       // shorter returns hit the robot itself and are dropped
   double max_range_m = 0.0;        // returns at or beyond this are misses; 0: the sensor's own maximum
   double no_return_clear_m = 0.0;  // a beam with no return clears this far; 0: not at all
+  // Range noise: each return becomes the mean of the returns of up to this many beams on either
+  // side that lie within smooth_max_step_m of it (the same surface), so a flat wall's noise falls by
+  // the square root of their count while an edge keeps its own side. 0: the ranges as measured.
+  int smooth_beams = 0;
+  double smooth_max_step_m = 0.05;
 };
 
 // ranges, angles (counter-clockwise, sensor frame) and fractions (each beam's time within the scan,
