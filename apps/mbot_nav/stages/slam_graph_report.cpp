@@ -16,14 +16,16 @@ Json MeanStdJson(const motion::MeanStd& m) { return {{"mean", Number(m.mean)}, {
 }  // namespace
 
 Json GraphSlamJson(const mapping::GraphSlamStats& g) {
-  mbot::log::Info(
-      "slam: graph of " + std::to_string(g.nodes) + " nodes in " + std::to_string(g.submaps) + " submaps; " +
-      std::to_string(g.loop_closures) + " loop closures from " + std::to_string(g.loop_searches) + " searches (" +
-      std::to_string(g.loop_searches_bounded) + " narrowed by the drift bound), " + std::to_string(g.rejected.size()) +
-      " rejected by the robust loss; " + std::to_string(g.sparse_scans) + " scans too sparse to match; " +
-      std::to_string(g.recoveries) + " scans placed by a recovery search (of " + std::to_string(g.recovery_searches) +
-      ", " + std::to_string(g.doubtful_searches) + " for odometry gaps or restarts); " +
-      std::to_string(g.degenerate_scans) + " scans moved by odometry along a corridor");
+  mbot::log::Info("slam: graph of " + std::to_string(g.nodes) + " nodes in " + std::to_string(g.submaps) +
+                  " submaps; " + std::to_string(g.loop_closures) + " loop closures from " +
+                  std::to_string(g.loop_searches) + " searches (" + std::to_string(g.loop_searches_bounded) +
+                  " narrowed by the drift bound; " + std::to_string(g.loop_closures_contradicted) +
+                  " more dropped as a neighbouring submap placed them elsewhere), " +
+                  std::to_string(g.rejected.size()) + " rejected by the robust loss; " +
+                  std::to_string(g.sparse_scans) + " scans too sparse to match; " + std::to_string(g.recoveries) +
+                  " scans placed by a recovery search (of " + std::to_string(g.recovery_searches) + ", " +
+                  std::to_string(g.doubtful_searches) + " for odometry gaps or restarts); " +
+                  std::to_string(g.degenerate_scans) + " scans moved by odometry along a corridor");
   for (size_t i = 0; i < g.rejected.size() && i < 5; ++i) {
     const mapping::RejectedClosure& r = g.rejected[i];
     mbot::log::Warn(
@@ -46,6 +48,8 @@ Json GraphSlamJson(const mapping::GraphSlamStats& g) {
           {"loop_searches", g.loop_searches},
           {"loop_closures", g.loop_closures},
           {"loop_searches_bounded", g.loop_searches_bounded},
+          {"loop_closures_contradicted", g.loop_closures_contradicted},
+          {"loop_closures_unverified", g.loop_closures_unverified},
           {"optimizations", g.optimizations},
           {"front_end_s", Number(g.front_end_s)},
           {"loop_search_s", Number(g.loop_search_s)},

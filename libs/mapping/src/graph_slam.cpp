@@ -241,7 +241,35 @@ void GraphSlam::QueueSearches(int node, int submap) {
   if (w.linear_m < options_.loop_window.linear_m || w.angular_rad < options_.loop_window.angular_rad) {
     ++stats_.loop_searches_bounded;
   }
-  pending_.push_back({node, submap, w});
+  // The neighbour that verifies a closure: finished, sharing nodes with the submap, not holding the node.
+  int verify = -1;
+  if (options_.loop_verify_tolerance_m > 0) {
+    for (int v : {submap + 1, submap - 1}) {
+      if (v < 0 || v >= static_cast<int>(submaps_.size()) || !submaps_[v].finished) continue;
+      if (std::find(n.submaps.begin(), n.submaps.end(), v) != n.submaps.end()) continue;
+      verify = v;
+      break;
+    }
+  }
+  pending_.push_back({node, submap, w, verify});
+}
+
+ClosureCheck VerifyClosure(const MatchGrid& neighbour, const std::vector<Point2>& points,
+                           const std::vector<Point2>& loop_points, const Pose2D& implied, const GraphSlamOptions& o) {
+  const MatchResult v = MatchBranchAndBound(neighbour, loop_points, implied, o.loop_verify_window, o.loop_min_score);
+  if (!v.found) return ClosureCheck::kUnverifiable;
+  // Off the search's lattice of cells, as the closure itself was.
+  const Pose2D found = RefineMatch(neighbour, points, v.pose, o.refine);
+  // Along a corridor neither submap can tell where the node is: only the disagreement across it counts.
+  double dx = found.x - implied.x, dy = found.y - implied.y;
+  if (o.front_min_constraint_ratio > 0) {
+    const TranslationConstraint tc = ScanTranslationConstraint(points, implied.theta);
+    if (tc.ratio() < o.front_min_constraint_ratio) {
+      const double ux = std::cos(tc.weak_axis_rad), uy = std::sin(tc.weak_axis_rad), along = dx * ux + dy * uy;
+      dx -= along * ux, dy -= along * uy;
+    }
+  }
+  return std::hypot(dx, dy) > o.loop_verify_tolerance_m ? ClosureCheck::kContradicted : ClosureCheck::kConfirmed;
 }
 
 SearchWindow LoopSearchWindow(const GraphSlamOptions& o, double path_m, bool doubtful) {
@@ -272,6 +300,8 @@ std::unique_ptr<GraphSlam::Job> GraphSlam::MakeJob(int iterations, bool render) 
     job->search_loop_points.push_back(nodes_[q.node].loop_points);
     job->search_fields.push_back(submaps_[q.submap].loop);
     job->search_submap_local.push_back(submaps_[q.submap].local);
+    job->verify_fields.push_back(q.verify >= 0 ? submaps_[q.verify].loop : nullptr);
+    job->verify_submap_local.push_back(q.verify >= 0 ? submaps_[q.verify].local : Pose2D{});
   }
   for (const Node& n : nodes_) job->nodes.push_back(n.global);
   for (const Submap& s : submaps_) job->submaps.push_back(s.global);
@@ -297,6 +327,19 @@ void GraphSlam::RunJob(Job* job) const {
     ++job->searched;
     if (!m.found) continue;
     const Pose2D refined = RefineMatch(field, *job->search_points[i], m.pose, options_.refine);
+    if (q.verify >= 0) {
+      // Where the closure puts the node, in the neighbour's grid; the neighbour must find it there.
+      const Pose2D global = job->submaps[q.submap].Compose(origin.Inverse().Compose(refined));
+      const Pose2D& v_origin = job->verify_submap_local[i];
+      const Pose2D implied = v_origin.Compose(job->submaps[q.verify].Inverse().Compose(global));
+      const ClosureCheck check = VerifyClosure(job->verify_fields[i]->Get(), *job->search_points[i],
+                                               *job->search_loop_points[i], implied, options_);
+      if (check == ClosureCheck::kUnverifiable) ++job->unverified;
+      if (check == ClosureCheck::kContradicted) {
+        ++job->contradicted;
+        continue;
+      }
+    }
     job->found.push_back({PoseConstraint::kLoopClosure, q.submap, q.node, origin.Inverse().Compose(refined),
                           options_.loop_translation_weight, options_.loop_rotation_weight, m.score});
   }
@@ -331,6 +374,8 @@ void GraphSlam::ApplyJob(Job* job) {
   constraints_.insert(constraints_.end(), job->found.begin(), job->found.end());
   stats_.loop_searches += job->searched;
   stats_.loop_closures += static_cast<int64_t>(job->found.size());
+  stats_.loop_closures_contradicted += job->contradicted;
+  stats_.loop_closures_unverified += job->unverified;
   ++stats_.optimizations;
   stats_.optimize_s += job->summary.seconds;
   stats_.loop_search_s += job->search_s;

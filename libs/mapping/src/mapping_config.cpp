@@ -226,6 +226,14 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
                              "loop search: the local window grows by this per metre of path between the submap and "
                              "the node, up to loop_window_m (0: loop_window_m alone)",
                              0.0, 10.0);
+  g.loop_verify_tolerance_m = num("loop_verify_tolerance_m", g.loop_verify_tolerance_m,
+                                  "a closure is dropped when the neighbouring submap finds the node farther than this "
+                                  "from where the closure puts it (0: no verification)",
+                                  0.0, 10.0);
+  g.loop_verify_window.linear_m = num("loop_verify_window_m", g.loop_verify_window.linear_m,
+                                      "verification: the neighbour's search window, +-", 0.0, 10.0);
+  g.loop_verify_window.angular_rad = num("loop_verify_window_rad", g.loop_verify_window.angular_rad,
+                                         "verification: the neighbour's angular window, +-", 0.0, M_PI);
   g.loop_drift_rad_per_m = num("loop_drift_rad_per_m", g.loop_drift_rad_per_m,
                                "loop search: the local window's heading grows by this per metre of path, up to "
                                "loop_window_rad (0: loop_window_rad alone)",

@@ -75,6 +75,13 @@ struct GraphSlamOptions {
   // in it is unbounded (loop_window). 0: the loop window alone.
   double loop_drift_m_per_m = 0.02;
   double loop_drift_rad_per_m = 0.01;
+  // A closure found in a submap is verified in a neighbouring finished submap (the one before or
+  // after it, which shares nodes with it) that the node is not in: searched there over this window
+  // around the pose the closure implies, the node must be found within loop_verify_tolerance_m of
+  // it. Found elsewhere, the closure is dropped; not found at all (the neighbour saw too little of
+  // the place), it stands. 0: no verification.
+  SearchWindow loop_verify_window{0.15, 0.1, 0.005};
+  double loop_verify_tolerance_m = 0.1;
   int loop_every_nodes = 5;  // search every k-th node
   int loop_levels = 8;       // branch-and-bound levels of a finished submap
   PoseGraphOptions graph{10.0, 50, 1};
@@ -89,6 +96,15 @@ struct GraphSlamOptions {
 // grown by the drift rates times the path, never beyond loop_window.
 SearchWindow LoopSearchWindow(const GraphSlamOptions& options, double path_m, bool doubtful);
 
+// A closure checked in a neighbouring finished submap: the node searched there (loop_verify_window,
+// loop_min_score) around `implied`, the pose the closure puts it at in that submap's grid, is found
+// within loop_verify_tolerance_m of it (across the corridor only, when `points` cannot pin its
+// position down along one: front_min_constraint_ratio), found elsewhere, or not found.
+enum class ClosureCheck { kConfirmed, kContradicted, kUnverifiable };
+ClosureCheck VerifyClosure(const MatchGrid& neighbour, const std::vector<Point2>& points,
+                           const std::vector<Point2>& loop_points, const motion::Pose2D& implied,
+                           const GraphSlamOptions& options);
+
 struct RejectedClosure {
   int node = 0, submap = 0;
   double score = 0, residual = 0;
@@ -100,7 +116,10 @@ struct GraphSlamStats {
   int doubtful_searches = 0;                  // of the searches: those the odometry's gap or restart asked for
   int degenerate_scans = 0;                   // whose motion along a corridor came from odometry
   int64_t loop_searches = 0, loop_closures = 0;
-  int64_t loop_searches_bounded = 0;      // of the searches: those the path's drift bound kept inside loop_window
+  int64_t loop_searches_bounded = 0;  // of the searches: those the path's drift bound kept inside loop_window
+  // Of the closures found: those a neighbouring submap placed elsewhere (dropped), and those it
+  // could not place at all (kept unverified).
+  int64_t loop_closures_contradicted = 0, loop_closures_unverified = 0;
   std::vector<RejectedClosure> rejected;  // by the robust loss, at the last solve
   int optimizations = 0;
   double optimize_s = 0, loop_search_s = 0, front_end_s = 0, render_s = 0;
@@ -176,6 +195,7 @@ class GraphSlam {
   struct Search {
     int node = 0, submap = 0;
     SearchWindow window;
+    int verify = -1;  // the finished neighbour submap that verifies a closure found (-1: none)
   };
   struct ScanAnchor {
     int node = 0;
@@ -186,8 +206,8 @@ class GraphSlam {
   struct Job {
     std::vector<Search> searches;
     std::vector<std::shared_ptr<const std::vector<Point2>>> search_points, search_loop_points;
-    std::vector<std::shared_ptr<const LoopField>> search_fields;
-    std::vector<motion::Pose2D> search_submap_local;
+    std::vector<std::shared_ptr<const LoopField>> search_fields, verify_fields;
+    std::vector<motion::Pose2D> search_submap_local, verify_submap_local;
     std::vector<motion::Pose2D> nodes, submaps;
     std::vector<PoseConstraint> constraints;  // the found loop closures are appended
     std::vector<ScanAnchor> scans;            // for the re-render (empty: none)
@@ -196,7 +216,7 @@ class GraphSlam {
     std::vector<PoseConstraint> found;
     PoseGraphSummary summary;
     std::vector<RejectedClosure> rejected;
-    int64_t searched = 0;
+    int64_t searched = 0, contradicted = 0, unverified = 0;
     double search_s = 0, render_s = 0;
     std::optional<LogOddsMapper> map;
   };
