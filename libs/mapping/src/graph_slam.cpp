@@ -234,7 +234,8 @@ void GraphSlam::FinishSubmap(int index) {
 
 void GraphSlam::QueueSearches(int node, int submap) {
   const Node& n = nodes_[node];
-  if (std::find(n.submaps.begin(), n.submaps.end(), submap) != n.submaps.end()) return;
+  const auto holds = [&](int s) { return std::find(n.submaps.begin(), n.submaps.end(), s) != n.submaps.end(); };
+  if (holds(submap)) return;
   const Submap& s = submaps_[submap];
   if (std::hypot(n.global.x - s.global.x, n.global.y - s.global.y) > options_.loop_max_distance_m) return;
   const SearchWindow w = LoopWindow(n, s);
@@ -245,8 +246,7 @@ void GraphSlam::QueueSearches(int node, int submap) {
   int verify = -1;
   if (options_.loop_verify_tolerance_m > 0) {
     for (int v : {submap + 1, submap - 1}) {
-      if (v < 0 || v >= static_cast<int>(submaps_.size()) || !submaps_[v].finished) continue;
-      if (std::find(n.submaps.begin(), n.submaps.end(), v) != n.submaps.end()) continue;
+      if (v < 0 || v >= static_cast<int>(submaps_.size()) || !submaps_[v].finished || holds(v)) continue;
       verify = v;
       break;
     }

@@ -168,9 +168,13 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
       count("min_points", g.min_points, "scans with fewer returns are not matched (they are counted)", 1, 100000);
   g.local_search = s.GetBool("graph_local_search", g.local_search,
                              "front end: correlative search before the Ceres fit (false: the fit alone)");
-  g.local_window.linear_m = num("local_window_m", g.local_window.linear_m, "front end: search window, +-", 0.0, 10.0);
-  g.local_window.angular_rad =
-      num("local_window_rad", g.local_window.angular_rad, "front end: angular search window, +-", 0.0, M_PI);
+  // A search window: `<prefix>_m` and `<prefix>_rad`, ± around the start.
+  auto window = [&](const std::string& prefix, SearchWindow* w, const std::string& what, double max_linear_m) {
+    w->linear_m = num((prefix + "_m").c_str(), w->linear_m, (what + " search window, +-").c_str(), 0.0, max_linear_m);
+    w->angular_rad =
+        num((prefix + "_rad").c_str(), w->angular_rad, (what + " angular search window, +-").c_str(), 0.0, M_PI);
+  };
+  window("local_window", &g.local_window, "front end:", 10.0);
   g.recover_below = num("recover_below", g.recover_below,
                         "front end: a fit below this share of the running mean score is searched again over the "
                         "recovery window (0: never)",
@@ -179,10 +183,7 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
                         "front end: an odometry gap longer than this around a scan, or a zeroed restart, searches the "
                         "recovery window whatever the fit scored (0: never)",
                         0.0, 3600.0);
-  g.recover_window.linear_m =
-      num("recover_window_m", g.recover_window.linear_m, "front end: recovery search window, +-", 0.0, 20.0);
-  g.recover_window.angular_rad =
-      num("recover_window_rad", g.recover_window.angular_rad, "front end: recovery angular window, +-", 0.0, M_PI);
+  window("recover_window", &g.recover_window, "front end: recovery", 20.0);
   g.front_min_constraint_ratio =
       num("front_min_constraint_ratio", g.front_min_constraint_ratio,
           "front end: a scan whose surfaces pin its position down along one direction only (weakest over strongest "
@@ -213,9 +214,7 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
           "weight of consecutive nodes' relative position by odometry (0: none)", 0.0, 1e12);
   g.odometry_rotation_weight = num("odometry_rotation_weight", g.odometry_rotation_weight,
                                    "weight of consecutive nodes' relative heading by odometry (0: none)", 0.0, 1e12);
-  g.loop_window.linear_m = num("loop_window_m", g.loop_window.linear_m, "loop closure: search window, +-", 0.0, 100.0);
-  g.loop_window.angular_rad =
-      num("loop_window_rad", g.loop_window.angular_rad, "loop closure: angular search window, +-", 0.0, M_PI);
+  window("loop_window", &g.loop_window, "loop closure:", 100.0);
   g.loop_window.min_angular_step_rad =
       num("loop_angular_step_rad", g.loop_window.min_angular_step_rad,
           "loop closure: the finest angular step (0: one cell at the farthest point)", 0.0, 1.0);
@@ -226,18 +225,15 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
                              "loop search: the local window grows by this per metre of path between the submap and "
                              "the node, up to loop_window_m (0: loop_window_m alone)",
                              0.0, 10.0);
-  g.loop_verify_tolerance_m = num("loop_verify_tolerance_m", g.loop_verify_tolerance_m,
-                                  "a closure is dropped when the neighbouring submap finds the node farther than this "
-                                  "from where the closure puts it (0: no verification)",
-                                  0.0, 10.0);
-  g.loop_verify_window.linear_m = num("loop_verify_window_m", g.loop_verify_window.linear_m,
-                                      "verification: the neighbour's search window, +-", 0.0, 10.0);
-  g.loop_verify_window.angular_rad = num("loop_verify_window_rad", g.loop_verify_window.angular_rad,
-                                         "verification: the neighbour's angular window, +-", 0.0, M_PI);
   g.loop_drift_rad_per_m = num("loop_drift_rad_per_m", g.loop_drift_rad_per_m,
                                "loop search: the local window's heading grows by this per metre of path, up to "
                                "loop_window_rad (0: loop_window_rad alone)",
                                0.0, 10.0);
+  g.loop_verify_tolerance_m = num("loop_verify_tolerance_m", g.loop_verify_tolerance_m,
+                                  "a closure is dropped when the neighbouring submap finds the node farther than this "
+                                  "from where the closure puts it (0: no verification)",
+                                  0.0, 10.0);
+  window("loop_verify_window", &g.loop_verify_window, "verification: the neighbour's", 10.0);
   g.loop_every_nodes =
       count("loop_every_nodes", g.loop_every_nodes, "search loop closures for every k-th node", 1, 100000);
   g.loop_levels = count("loop_levels", g.loop_levels, "branch-and-bound levels of a finished submap", 1, 12);

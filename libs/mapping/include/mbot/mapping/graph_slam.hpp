@@ -70,7 +70,7 @@ struct GraphSlamOptions {
   double loop_max_distance_m = 10.0;  // node to submap origin, by the current estimate
   // The front end's drift bounds a closure's correction: a node is searched in a finished submap
   // over the local window grown by these rates times the path the front end drove between the
-  // submap's last node and the node (capped by loop_window). A look-alike place farther than the
+  // nearer end of the submap's nodes and the node (capped by loop_window). A look-alike place farther than the
   // matched path can have drifted is never searched. A path with a recovery or doubtful odometry
   // in it is unbounded (loop_window). 0: the loop window alone.
   double loop_drift_m_per_m = 0.02;
