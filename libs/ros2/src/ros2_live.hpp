@@ -30,8 +30,11 @@ struct Ros2NodeOptions {
   DdsOptions dds;
   msgs::TopicTable topics = DefaultTopics();
   Frames frames;
-  int64_t wait_for_mount_us = 3000000;  // scans without a mount are dropped this long (then: centre)
-  std::string robot_frame;              // whose transform to the scan's frame is the lidar's mount ("" = /odom's child)
+  // Scans without a mount are dropped this long (then: centre). A latched /tf_static reaches a reader
+  // only after discovery and the writer's resend: from a Fast DDS robot on a loaded machine that took
+  // more than 3 s, and the scans mapped meanwhile with the lidar at the centre stayed in the map.
+  int64_t wait_for_mount_us = 10000000;
+  std::string robot_frame;  // whose transform to the scan's frame is the lidar's mount ("" = /odom's child)
   // ROS types of the topics read (pipeline topic → type); the MBot's by default (DefaultRosType).
   std::map<std::string, std::string> types;
 };
