@@ -14,11 +14,13 @@ LogOddsMapper::LogOddsMapper(const MapperOptions& options) : options_(options) {
   const int h = static_cast<int>(std::ceil(options.height_m / options.resolution_m));
   map_ = OccupancyGrid(w, h, options.resolution_m, options.center_x_m - 0.5 * w * options.resolution_m,
                        options.center_y_m - 0.5 * h * options.resolution_m);
+  if (options_.hit_moments) moments_.Reset(map_);
 }
 
 void LogOddsMapper::Reset(OccupancyGrid map) {
   options_.resolution_m = map.resolution();
   map_ = std::move(map);
+  if (options_.hit_moments) moments_.Reset(map_);
 }
 
 bool LogOddsMapper::EnsureCovers(double min_x, double min_y, double max_x, double max_y) {
@@ -46,6 +48,7 @@ bool LogOddsMapper::EnsureCovers(double min_x, double min_y, double max_x, doubl
                 &grown.cells()[static_cast<size_t>(y + bottom) * grown.width() + left]);
   }
   map_ = std::move(grown);
+  if (options_.hit_moments) moments_.Grow(map_, left, bottom);
   ++grow_count_;
   return true;
 }
@@ -164,8 +167,12 @@ bool LogOddsMapper::Insert(const std::vector<ScanRay>& rays, const motion::Pose2
     for (size_t k = 0; k < n; ++k) {
       if (!map_.IsInside(xs[k], ys[k])) continue;
       int8_t& cell = map_.at(xs[k], ys[k]);
-      const int v = (k + 1 == n && w.hit) ? std::min(127, cell + hit) : std::max(-127, cell - miss);
+      const bool end_hit = k + 1 == n && w.hit;
+      const int v = end_hit ? std::min(127, cell + hit) : std::max(-127, cell - miss);
       cell = static_cast<int8_t>(v);
+      if (end_hit && options_.hit_moments) {
+        moments_.Add(map_, xs[k], ys[k], w.ex, w.ey, HitMoments::DirectionOf(std::atan2(w.ey - w.oy, w.ex - w.ox)));
+      }
     }
   }
   return true;

@@ -214,6 +214,11 @@ FilterStatus ParticleFilter::Update(const ActionModel& action, const OdometrySte
   return status_;
 }
 
+void ParticleFilter::Shift(const motion::Pose2D& correction) {
+  for (Particle& p : particles_) p.pose = correction.Compose(p.pose);
+  status_.pose = correction.Compose(status_.pose);
+}
+
 void ParticleFilter::Estimate() {
   const size_t n = particles_.size();
   const size_t k = std::max<size_t>(1, static_cast<size_t>(std::ceil(options_.top_fraction * n)));

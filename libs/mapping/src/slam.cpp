@@ -34,9 +34,17 @@ std::string SlamEventTracker::Add(double t, int scan, bool updated, const Filter
   return said;
 }
 
+namespace {
+MapperOptions WithMoments(const SlamOptions& o) {
+  MapperOptions m = o.mapper;
+  m.hit_moments = m.hit_moments || (o.refine_estimate && o.mode == SlamMode::kFullSlam);
+  return m;
+}
+}  // namespace
+
 Slam::Slam(const SlamOptions& options, uint64_t seed)
     : options_(options),
-      mapper_(options.mapper),
+      mapper_(WithMoments(options)),
       action_(options.action),
       sensor_(options.sensor),
       no_map_sensor_(options.sensor),
@@ -97,8 +105,19 @@ SlamStep Slam::ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2
     const ScanPoints points = model.Prepare(rays);
     const OdometryStep step = ActionModel::StepBetween(last_odometry_, odometry);
     filter_.Update(action_, step, model, points);
+    motion::Pose2D estimate = filter_.status().pose;
+    if (weigh && options_.refine_estimate) {
+      const std::vector<NdtPoint> hits = NdtPoints(rays);
+      if (hits.size() >= 10) {
+        const motion::Pose2D before = filter_.status().pose;
+        const motion::Pose2D fitted = RefineNdt(mapper_.map(), mapper_.moments(), hits, before, options_.refine).pose;
+        const motion::Pose2D correction = fitted.Compose(before.Inverse());
+        if (options_.refine_shift_particles) filter_.Shift(correction);
+        estimate = fitted;
+      }
+    }
     last_odometry_ = odometry;
-    last_estimate_ = filter_.status().pose;
+    last_estimate_ = estimate;
     out.filter_updated = true;
   }
   out.status = filter_.status();

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "mbot/mapping/moving_scan.hpp"
+#include "mbot/mapping/ndt.hpp"
 #include "mbot/mapping/occupancy_grid.hpp"
 #include "mbot/motion/pose2d.hpp"
 
@@ -22,6 +23,7 @@ struct MapperOptions {
   double center_y_m = 0.0;
   bool grow = true;           // false: rays leaving the extent are clipped (never past kMaxGridCells)
   double grow_block_m = 5.0;  // the extent grows by multiples of this
+  bool hit_moments = false;   // keep each cell's hit moments (ndt.hpp) beside the grid
 };
 
 class LogOddsMapper {
@@ -36,6 +38,9 @@ class LogOddsMapper {
   bool Insert(const std::vector<ScanRay>& rays, const motion::Pose2D& robot_pose);
 
   const OccupancyGrid& map() const { return map_; }
+  // The hits' moments per cell (options.hit_moments; empty otherwise). A map given to Reset starts
+  // with none: its cells' hits are not known.
+  const HitMoments& moments() const { return moments_; }
   int grow_count() const { return grow_count_; }
   int rejected_scans() const { return rejected_scans_; }
 
@@ -44,6 +49,7 @@ class LogOddsMapper {
 
   MapperOptions options_;
   OccupancyGrid map_;
+  HitMoments moments_;
   int grow_count_ = 0;
   int rejected_scans_ = 0;
 };

@@ -89,6 +89,8 @@ class ParticleFilter {
 
   const std::vector<Particle>& particles() const { return particles_; }
   const FilterStatus& status() const { return status_; }
+  // Moves every particle and the estimate by `correction` (map frame: p ← correction ∘ p).
+  void Shift(const motion::Pose2D& correction);
   int64_t updates() const { return updates_; }
 
  private:

@@ -18,6 +18,8 @@
 #include "mbot/mapping/log_odds_mapper.hpp"
 #include "mbot/mapping/moving_scan.hpp"
 #include "mbot/mapping/particle_filter.hpp"
+#include "mbot/mapping/ndt.hpp"
+#include "mbot/mapping/scan_matching.hpp"
 #include "mbot/mapping/sensor_model.hpp"
 #include "mbot/msgs/status.hpp"
 
@@ -43,6 +45,13 @@ struct SlamOptions {
   // localization is switched off (the fit is then taken against a map that may be far behind).
   double gate_fit_ratio = 0.5;
   int gate_max_scans = 3;
+  // Full SLAM: after each filter update the estimate is fitted to the hits the map holds (the
+  // normal-distributions transform of ndt.hpp, held near the filter's answer by `refine`'s priors),
+  // and every particle moves by the same correction. The filter weighs whole cells; the fit places
+  // the scan between them.
+  bool refine_estimate = false;
+  NdtOptions refine;
+  bool refine_shift_particles = true;
 };
 
 struct SlamStep {
