@@ -53,6 +53,29 @@ TEST(FrontiersTest, OccupiedCellsAreNeverFrontiers) {
   EXPECT_TRUE(FindFrontiers(g, {1, 1.0}).empty());
 }
 
+// A room's wall with two gaps to unknown space beyond: a crack 0.15 m wide (three cells) and a
+// doorway 0.4 m wide. With min_width_m 0.25 (a 0.2 m robot and a cell) the crack is one.
+TEST(FrontiersTest, ACrackNarrowerThanTheRobotIsToldFromADoorway) {
+  OccupancyGrid g(40, 40, 0.05, 0, 0, 0);
+  for (int y = 0; y < 40; ++y) {
+    for (int x = 0; x < 20; ++x) g.at(x, y) = -100;  // the room; x >= 21 is unknown
+    g.at(20, y) = 100;                               // its wall
+  }
+  for (int y = 5; y < 8; ++y) g.at(20, y) = -100;    // the crack, cells 5-7
+  for (int y = 20; y < 28; ++y) g.at(20, y) = -100;  // the doorway, cells 20-27
+  FrontierOptions o{1, 1.0};
+  o.min_width_m = 0.25;
+  const std::vector<Frontier> f = FindFrontiers(g, o);  // both are frontiers still
+  ASSERT_EQ(f.size(), 2u);
+  EXPECT_NEAR(f[0].centroid_y, 24 * 0.05, 1e-9);  // the doorway's middle: the larger first
+  EXPECT_FALSE(IsCrack(f[0], g, o));
+  EXPECT_TRUE(IsCrack(f[1], g, o));
+  o.min_width_m = 0.5;  // a robot wider than the doorway
+  EXPECT_TRUE(IsCrack(f[0], g, o));
+  o.min_width_m = 0.0;
+  EXPECT_FALSE(IsCrack(f[1], g, o));
+}
+
 // A free 2 m x 1.9 m room whose right side opens to unknown space.
 OccupancyGrid RoomOpenToTheRight() {
   OccupancyGrid g(60, 40, 0.05, 0, 0, 0);

@@ -72,6 +72,30 @@ std::vector<Frontier> FindFrontiers(const mapping::OccupancyGrid& map, const Fro
   return out;
 }
 
+bool IsCrack(const Frontier& f, const mapping::OccupancyGrid& map, const FrontierOptions& options) {
+  if (!(options.min_width_m > 0)) return false;
+  // A crack holds no more frontier cells than fit across it (and one more, on a slant).
+  if (f.size() > static_cast<int>(std::ceil(options.min_width_m / map.resolution())) + 1) return false;
+  const int w = map.width(), h = map.height();
+  const auto& cells = map.cells();
+  // Open where some cell has no occupied cell within half the width: the gap there is wider.
+  const int r = static_cast<int>(std::ceil(0.5 * options.min_width_m / map.resolution()));
+  const double r2 = std::pow(0.5 * options.min_width_m / map.resolution(), 2);
+  auto clear = [&](int c) {
+    const int cx = c % w, cy = c / w;
+    for (int dy = -r; dy <= r; ++dy) {
+      for (int dx = -r; dx <= r; ++dx) {
+        const int x = cx + dx, y = cy + dy;
+        if (dx * dx + dy * dy <= r2 && x >= 0 && y >= 0 && x < w && y < h &&
+            cells[static_cast<size_t>(y) * w + x] >= options.occupied_threshold)
+          return false;
+      }
+    }
+    return true;
+  };
+  return !std::any_of(f.cells.begin(), f.cells.end(), clear);
+}
+
 FrontierLayers ComputeFrontierLayers(const mapping::OccupancyGrid& map, const FrontierOptions& options) {
   FrontierLayers layers;
   const int w = map.width();

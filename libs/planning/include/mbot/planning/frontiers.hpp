@@ -20,6 +20,8 @@ struct FrontierOptions {
   // that crosses a cell: the default asks for about twenty.
   int free_threshold = -20;
   int occupied_threshold = 1;
+  // A crack (IsCrack) is a region narrower than this (0: none is).
+  double min_width_m = 0.0;
 };
 
 struct Frontier {
@@ -33,6 +35,11 @@ struct Frontier {
 // free nor occupied, grouped 8-connected by BFS; regions smaller than options.min_cells are dropped.
 // Sorted by size, largest first.
 std::vector<Frontier> FindFrontiers(const mapping::OccupancyGrid& map, const FrontierOptions& options);
+
+// Whether `f` is a crack in a wall narrower than options.min_width_m: no more cells than fit across
+// that width (and one), none farther than half of it from an occupied cell. The robot can neither
+// enter it nor see much through it.
+bool IsCrack(const Frontier& f, const mapping::OccupancyGrid& map, const FrontierOptions& options);
 
 // What the frontier detection sees in a map, as cell centres (world frame) for a picture: cells
 // seen too faintly to count as free or occupied (between the thresholds, not unknown), and the
