@@ -7,9 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 #include <random>
 
 #include "mbot/mapping/log_odds_mapper.hpp"
+#include "mbot/mapping/particle_filter.hpp"
 #include "mbot/mapping/slam.hpp"
 #include "room_fixture.hpp"
 
@@ -41,12 +43,17 @@ TEST(Ndt, PlacesANoisyScanBetweenCellsAndTheMomentsFollowAGrowingGrid) {
   LogOddsMapper mapper(mo);
   std::mt19937 rng(7);
   for (int i = 0; i < 20; ++i) ASSERT_TRUE(mapper.Insert(NoisyScan(room, truth, 0.022, &rng), truth));
-  ASSERT_GT(mapper.grow_count(), 0);
+  // Then a return far to the south-west: the grid grows on its left and bottom, and every cell's
+  // moments must move with it (the fits below would miss the walls otherwise).
+  const int grown = mapper.grow_count();
+  const Pose2D far = truth.Inverse().Compose(Pose2D{-8.0, -8.0, 0});
+  ASSERT_TRUE(mapper.Insert({ScanRay{0, 0, float(far.x), float(far.y), true}}, truth));
+  ASSERT_GT(mapper.grow_count(), grown);
   double hits = 0;
   for (int y = 0; y < mapper.moments().height(); ++y)
     for (int x = 0; x < mapper.moments().width(); ++x)
       for (int k = 0; k < HitMoments::kDirections; ++k) hits += mapper.moments().at(x, y, k).n;
-  EXPECT_EQ(hits, 20 * 360);
+  EXPECT_EQ(hits, 20 * 360 + 1);
 
   NdtOptions o;
   o.translation_weight = o.rotation_weight = 0.0;  // the scan alone
@@ -60,9 +67,13 @@ TEST(Ndt, PlacesANoisyScanBetweenCellsAndTheMomentsFollowAGrowingGrid) {
     EXPECT_NEAR(r.pose.y, truth.y, 0.003);
     EXPECT_NEAR(r.pose.theta, truth.theta, 0.1 * kDeg);
   }
-  // With no hit moments (a map given whole), nothing moves.
-  const HitMoments none;
-  EXPECT_EQ(RefineNdt(mapper.map(), none, points, truth, o).points_used, 0);
+  // A map given whole has no hits' moments: nothing moves.
+  LogOddsMapper given(mo);
+  given.Reset(mapper.map());
+  const Pose2D start{truth.x + 0.02, truth.y, truth.theta};
+  const NdtResult none = RefineNdt(given.map(), given.moments(), points, start, o);
+  EXPECT_EQ(none.points_used, 0);
+  EXPECT_EQ(none.pose.x, start.x);
 }
 
 // Full SLAM from an empty map with the MBot's range noise and odometry whose heading drifts 0.3°
@@ -76,23 +87,48 @@ TEST(Ndt, FullSlamWithTheRefinedEstimateHoldsTheHeadingUnderRangeNoise) {
     o.mapper.width_m = o.mapper.height_m = 6.0;
     o.sensor.occupied_threshold = 30;
     o.refine_estimate = refine;
-    o.refine.occupied_threshold = 30;
     Slam slam(o, 3);
     std::mt19937 rng(11);
     Pose2D truth{-0.5, -0.5, 0}, odometry = truth;
     slam.Initialize(truth, odometry);
     for (int i = 0; i < 10; ++i) slam.ProcessScan(NoisyScan(room, truth, 0.022, &rng), odometry);  // standing
-    double worst = 0;
+    double worst = 0, worst_m = 0;
     for (int i = 1; i <= 40; ++i) {
       truth = truth.Compose(Pose2D{0.05, 0.0, (i <= 20 ? 2.0 : -2.0) * kDeg});
       odometry = odometry.Compose(Pose2D{0.05, 0.0, (i <= 20 ? 2.3 : -1.7) * kDeg});
       const SlamStep step = slam.ProcessScan(NoisyScan(room, truth, 0.022, &rng), odometry);
       worst = std::max(worst, std::abs(motion::WrapAngle(step.pose.theta - truth.theta)));
+      worst_m = std::max(worst_m, std::hypot(step.pose.x - truth.x, step.pose.y - truth.y));
     }
-    return worst / kDeg;
+    if (refine) {
+      EXPECT_GT(slam.estimates_refined(), 30);
+    }
+    return std::make_pair(worst / kDeg, worst_m);
   };
-  const double refined = run(true), filter_alone = run(false);
-  EXPECT_LT(refined, 0.3) << "the filter alone: " << filter_alone << " deg";
+  const auto refined = run(true), filter_alone = run(false);
+  EXPECT_LT(refined.first, 0.3);
+  EXPECT_LT(refined.second, 0.015);
+  EXPECT_GT(filter_alone.first, 2 * refined.first) << "the fit made no difference";
+}
+
+// Shift moves every particle and the estimate rigidly: p <- correction ∘ p.
+TEST(Ndt, ShiftMovesEveryParticleAndTheEstimateByTheCorrection) {
+  ParticleFilterOptions po;
+  po.particles = 50;
+  ParticleFilter f(po, 5);
+  f.InitializeAt({0.3, -0.2, 0.4}, 0.05, 0.1);
+  const std::vector<Particle> before = f.particles();
+  const Pose2D estimate = f.status().pose, correction{0.01, -0.02, 0.5 * kDeg};
+  f.Shift(correction);
+  for (size_t i = 0; i < before.size(); ++i) {
+    const Pose2D want = correction.Compose(before[i].pose);
+    EXPECT_NEAR(f.particles()[i].pose.x, want.x, 1e-12);
+    EXPECT_NEAR(f.particles()[i].pose.y, want.y, 1e-12);
+    EXPECT_NEAR(f.particles()[i].pose.theta, want.theta, 1e-12);
+  }
+  const Pose2D want = correction.Compose(estimate);
+  EXPECT_NEAR(f.status().pose.x, want.x, 1e-12);
+  EXPECT_NEAR(f.status().pose.theta, want.theta, 1e-12);
 }
 
 }  // namespace

@@ -53,27 +53,39 @@ TEST(FrontiersTest, OccupiedCellsAreNeverFrontiers) {
   EXPECT_TRUE(FindFrontiers(g, {1, 1.0}).empty());
 }
 
-// A room's wall with two gaps to unknown space beyond: a crack 0.15 m wide (three cells) and a
-// doorway 0.4 m wide. With min_width_m 0.25 (a 0.2 m robot and a cell) the crack is one.
-TEST(FrontiersTest, ACrackNarrowerThanTheRobotIsToldFromADoorway) {
+// A room's wall with a nook and a doorway behind which lies unknown space: the nook's unknown is
+// 2 x 3 cells between walls; the doorway opens onto the whole unknown half. With min_space_m 0.25 (a
+// 0.2 m robot and a cell) the nook is a pocket, the doorway not (too long), nor a small frontier in
+// the open (too far from any wall).
+TEST(FrontiersTest, APocketSmallerThanTheRobotIsToldFromADoorway) {
   OccupancyGrid g(40, 40, 0.05, 0, 0, 0);
   for (int y = 0; y < 40; ++y) {
     for (int x = 0; x < 20; ++x) g.at(x, y) = -100;  // the room; x >= 21 is unknown
     g.at(20, y) = 100;                               // its wall
   }
-  for (int y = 5; y < 8; ++y) g.at(20, y) = -100;    // the crack, cells 5-7
   for (int y = 20; y < 28; ++y) g.at(20, y) = -100;  // the doorway, cells 20-27
+  for (int y = 4; y < 9; ++y)                        // the nook: walls round unknown cells (18-19, 5-7)
+    for (int x = 17; x < 21; ++x) g.at(x, y) = (x == 17 || x == 20 || y == 4 || y == 8) ? 100 : 0;
+  for (int y = 5; y < 8; ++y) g.at(17, y) = -100;  // open to the room on its left
   FrontierOptions o{1, 1.0};
-  o.min_width_m = 0.25;
+  o.min_space_m = 0.25;
   const std::vector<Frontier> f = FindFrontiers(g, o);  // both are frontiers still
   ASSERT_EQ(f.size(), 2u);
-  EXPECT_NEAR(f[0].centroid_y, 24 * 0.05, 1e-9);  // the doorway's middle: the larger first
-  EXPECT_FALSE(IsCrack(f[0], g, o));
-  EXPECT_TRUE(IsCrack(f[1], g, o));
-  o.min_width_m = 0.5;  // a robot wider than the doorway
-  EXPECT_TRUE(IsCrack(f[0], g, o));
-  o.min_width_m = 0.0;
-  EXPECT_FALSE(IsCrack(f[1], g, o));
+  EXPECT_NEAR(f[0].centroid_y, 24 * 0.05, 1e-9);  // the doorway's: the larger first
+  EXPECT_FALSE(IsPocket(f[0], g, o));
+  EXPECT_TRUE(IsPocket(f[1], g, o));
+  o.min_space_m = 0.0;
+  EXPECT_FALSE(IsPocket(f[1], g, o));
+
+  // A one-cell unknown hole in the middle of the room: a frontier of four cells, far from every wall.
+  o.min_space_m = 0.25;
+  g.at(8, 30) = 0;
+  const std::vector<Frontier> h = FindFrontiers(g, o);
+  ASSERT_EQ(h.size(), 3u);
+  EXPECT_EQ(h[1].size(), 4);  // the doorway's 8, the hole's 4, the nook's 3
+  EXPECT_NEAR(h[1].centroid_y, 30.5 * 0.05, 1e-9);
+  EXPECT_FALSE(IsPocket(h[1], g, o)) << "the hole is open space";
+  EXPECT_TRUE(IsPocket(h[2], g, o));
 }
 
 // A free 2 m x 1.9 m room whose right side opens to unknown space.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace mbot::mapping {
 
@@ -14,13 +15,27 @@ LogOddsMapper::LogOddsMapper(const MapperOptions& options) : options_(options) {
   const int h = static_cast<int>(std::ceil(options.height_m / options.resolution_m));
   map_ = OccupancyGrid(w, h, options.resolution_m, options.center_x_m - 0.5 * w * options.resolution_m,
                        options.center_y_m - 0.5 * h * options.resolution_m);
-  if (options_.hit_moments) moments_.Reset(map_);
+  if (options_.hit_moments) {
+    if (static_cast<long long>(w) * h > HitMoments::kMaxCells) {
+      throw std::invalid_argument("mapper: a grid of " + std::to_string(static_cast<long long>(w) * h) +
+                                  " cells is too large to keep hit moments for (at most " +
+                                  std::to_string(HitMoments::kMaxCells) + ")");
+    }
+    moments_.Reset(map_);
+  }
 }
 
 void LogOddsMapper::Reset(OccupancyGrid map) {
   options_.resolution_m = map.resolution();
   map_ = std::move(map);
-  if (options_.hit_moments) moments_.Reset(map_);
+  if (options_.hit_moments) {
+    if (static_cast<long long>(map_.width()) * map_.height() > HitMoments::kMaxCells) {
+      throw std::invalid_argument(
+          "mapper: a map of " + std::to_string(static_cast<long long>(map_.width()) * map_.height()) +
+          " cells is too large to keep hit moments for (at most " + std::to_string(HitMoments::kMaxCells) + ")");
+    }
+    moments_.Reset(map_);
+  }
 }
 
 bool LogOddsMapper::EnsureCovers(double min_x, double min_y, double max_x, double max_y) {
@@ -37,7 +52,8 @@ bool LogOddsMapper::EnsureCovers(double min_x, double min_y, double max_x, doubl
   };
   const double grown_w = map_.width() + cells_needed(x0 - min_x) + cells_needed(max_x - x1 + res);
   const double grown_h = map_.height() + cells_needed(y0 - min_y) + cells_needed(max_y - y1 + res);
-  if (grown_w * grown_h > double(kMaxGridCells)) return false;
+  const double cap = options_.hit_moments ? double(HitMoments::kMaxCells) : double(kMaxGridCells);
+  if (grown_w * grown_h > cap) return false;
   const int left = static_cast<int>(cells_needed(x0 - min_x)), bottom = static_cast<int>(cells_needed(y0 - min_y));
   const int right = static_cast<int>(cells_needed(max_x - x1 + res));
   const int top = static_cast<int>(cells_needed(max_y - y1 + res));

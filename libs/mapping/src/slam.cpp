@@ -3,6 +3,7 @@
 #include "mbot/common/strings.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace mbot::mapping {
@@ -35,6 +36,11 @@ std::string SlamEventTracker::Add(double t, int scan, bool updated, const Filter
 }
 
 namespace {
+SlamOptions Refined(SlamOptions o) {
+  o.refine.occupied_threshold = o.sensor.occupied_threshold;  // the map the filter weighs on
+  return o;
+}
+
 MapperOptions WithMoments(const SlamOptions& o) {
   MapperOptions m = o.mapper;
   m.hit_moments = m.hit_moments || (o.refine_estimate && o.mode == SlamMode::kFullSlam);
@@ -43,7 +49,7 @@ MapperOptions WithMoments(const SlamOptions& o) {
 }  // namespace
 
 Slam::Slam(const SlamOptions& options, uint64_t seed)
-    : options_(options),
+    : options_(Refined(options)),
       mapper_(WithMoments(options)),
       action_(options.action),
       sensor_(options.sensor),
@@ -106,14 +112,21 @@ SlamStep Slam::ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2
     const OdometryStep step = ActionModel::StepBetween(last_odometry_, odometry);
     filter_.Update(action_, step, model, points);
     motion::Pose2D estimate = filter_.status().pose;
-    if (weigh && options_.refine_estimate) {
+    const FilterStatus& st = filter_.status();
+    if (weigh && options_.refine_estimate && st.converged && !st.lost && !st.relocalized) {
       const std::vector<NdtPoint> hits = NdtPoints(rays);
-      if (hits.size() >= 10) {
-        const motion::Pose2D before = filter_.status().pose;
-        const motion::Pose2D fitted = RefineNdt(mapper_.map(), mapper_.moments(), hits, before, options_.refine).pose;
-        const motion::Pose2D correction = fitted.Compose(before.Inverse());
+      const NdtResult r = RefineNdt(mapper_.map(), mapper_.moments(), hits, estimate, options_.refine);
+      // Taken where a quarter of the scan or more lies on the map's hits, and within three of the priors'
+      // deviations: a scan that does not fit (corrupt, misplaced, the world changed) moves nothing.
+      const motion::Pose2D correction = r.pose.Compose(estimate.Inverse());
+      const bool fits = hits.size() >= 10 && r.points_used >= 0.25 * hits.size();
+      const bool near =
+          std::hypot(r.pose.x - estimate.x, r.pose.y - estimate.y) * options_.refine.translation_weight <= 3.0 &&
+          std::abs(motion::WrapAngle(r.pose.theta - estimate.theta)) * options_.refine.rotation_weight <= 3.0;
+      if (fits && (near || options_.refine.translation_weight <= 0 || options_.refine.rotation_weight <= 0)) {
         if (options_.refine_shift_particles) filter_.Shift(correction);
-        estimate = fitted;
+        estimate = r.pose;
+        ++refined_;
       }
     }
     last_odometry_ = odometry;

@@ -147,9 +147,9 @@ std::vector<FrontierLeft> Explorer::FrontiersLeft(const mapping::OccupancyGrid& 
     const bool reachable = std::find(unreachable.begin(), unreachable.end(), i) == unreachable.end();
     bool for_good = false;
     const bool blacklisted = IsBlacklisted(all[i], t_s, &for_good);
-    // Seen from its target and still there, a crack narrower than the robot is no unexplored space:
+    // Seen from its target and still there, a pocket smaller than the robot is no unexplored space:
     // the robot cannot enter it, and the referee counts only what its body reaches.
-    if (for_good && IsCrack(all[i], map, options_.frontier)) continue;
+    if (for_good && IsPocket(all[i], map, options_.frontier)) continue;
     left.push_back({all[i].centroid_x, all[i].centroid_y, all[i].size(), reachable, blacklisted, for_good});
   }
   return left;

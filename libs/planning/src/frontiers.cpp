@@ -72,28 +72,29 @@ std::vector<Frontier> FindFrontiers(const mapping::OccupancyGrid& map, const Fro
   return out;
 }
 
-bool IsCrack(const Frontier& f, const mapping::OccupancyGrid& map, const FrontierOptions& options) {
-  if (!(options.min_width_m > 0)) return false;
-  // A crack holds no more frontier cells than fit across it (and one more, on a slant).
-  if (f.size() > static_cast<int>(std::ceil(options.min_width_m / map.resolution())) + 1) return false;
+bool IsPocket(const Frontier& f, const mapping::OccupancyGrid& map, const FrontierOptions& options) {
+  if (!(options.min_space_m > 0)) return false;
+  // No more cells than fit across the width (and one more, on a slant) ...
+  if (f.size() > static_cast<int>(std::ceil(options.min_space_m / map.resolution())) + 1) return false;
   const int w = map.width(), h = map.height();
   const auto& cells = map.cells();
-  // Open where some cell has no occupied cell within half the width: the gap there is wider.
-  const int r = static_cast<int>(std::ceil(0.5 * options.min_width_m / map.resolution()));
-  const double r2 = std::pow(0.5 * options.min_width_m / map.resolution(), 2);
-  auto clear = [&](int c) {
+  // ... and every one of them within half the width of an occupied cell: nowhere along it is the
+  // opening as wide as the body.
+  const double r = 0.5 * options.min_space_m / map.resolution();
+  const int k = static_cast<int>(std::ceil(r));
+  auto near_wall = [&](int c) {
     const int cx = c % w, cy = c / w;
-    for (int dy = -r; dy <= r; ++dy) {
-      for (int dx = -r; dx <= r; ++dx) {
+    for (int dy = -k; dy <= k; ++dy) {
+      for (int dx = -k; dx <= k; ++dx) {
         const int x = cx + dx, y = cy + dy;
-        if (dx * dx + dy * dy <= r2 && x >= 0 && y >= 0 && x < w && y < h &&
+        if (dx * dx + dy * dy <= r * r && x >= 0 && y >= 0 && x < w && y < h &&
             cells[static_cast<size_t>(y) * w + x] >= options.occupied_threshold)
-          return false;
+          return true;
       }
     }
-    return true;
+    return false;
   };
-  return !std::any_of(f.cells.begin(), f.cells.end(), clear);
+  return std::all_of(f.cells.begin(), f.cells.end(), near_wall);
 }
 
 FrontierLayers ComputeFrontierLayers(const mapping::OccupancyGrid& map, const FrontierOptions& options) {

@@ -64,10 +64,10 @@ FrontierOptions ParseFrontierOptions(config::Section& s, const FrontierOptions& 
   FrontierOptions o = d;
   o.min_cells = static_cast<int>(
       s.GetInt("min_frontier_cells", d.min_cells, "frontier regions with fewer cells are ignored", 1, 1000000));
-  o.min_width_m = s.GetDouble("min_frontier_width_m", d.min_width_m,
-                              "a frontier still there when seen from its target, no larger than this (one cell more) "
-                              "and with no cell farther than half this from an occupied cell, is a crack narrower than "
-                              "the robot: exploration ends complete without it (0: none is) [m]",
+  o.min_space_m = s.GetDouble("frontier_min_space_m", d.min_space_m,
+                              "a frontier still there when seen from its target, of no more cells than fit across this "
+                              "and each within half of it from a wall (a nook, a crack), is a pocket: exploration ends "
+                              "complete without it (0: none is) [m]",
                               0.0, 100.0);
   o.search_radius_m = s.GetDouble("frontier_search_radius_m", d.search_radius_m,
                                   "radius searched around a frontier's centroid for a reachable cell [m]", 0.0, 100.0);

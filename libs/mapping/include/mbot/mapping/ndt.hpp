@@ -34,6 +34,9 @@ class HitMoments {
   static constexpr int kDirections = 8;
   // The sector of a ray's direction [rad, map frame].
   static int DirectionOf(double angle_rad);
+  // The most cells a grid may have for its moments (kDirections × 24 bytes a cell) to stay within
+  // the memory a grid of kMaxGridCells cells of one byte may take.
+  static constexpr long long kMaxCells = kMaxGridCells / (kDirections * static_cast<long long>(sizeof(CellMoments)));
   // Sized for `grid`, all zero.
   void Reset(const OccupancyGrid& grid);
   // After `grid` grew by `left` and `bottom` cells on those sides (and others on the far sides): the
@@ -57,7 +60,6 @@ struct NdtOptions {
   int occupied_threshold = 0;   // a block with a cell above this log-odds lends its hits
   int min_hits = 10;            // a block with fewer hits scores nothing
   double min_sigma_m = 0.01;    // added to every Gaussian's spread (a wall seen once is not a line)
-  double max_elongation = 4.0;  // a block whose spread along exceeds this times across counts across only
   double outlier_sigmas = 3.0;  // points farther than this (Mahalanobis) from their block's mean weigh less
   // Pulls towards the initial pose: 1 / the prior's standard deviation (0: none), 5 cm and 6° by
   // default, looser than a particle filter's spread: its estimate is a mean over whole cells.
@@ -68,7 +70,7 @@ struct NdtOptions {
 
 struct NdtResult {
   motion::Pose2D pose;
-  int points_used = 0;  // points with a Gaussian at the final pose
+  int points_used = 0;  // points with a Gaussian, at the start of the last step
   int iterations = 0;
 };
 

@@ -48,7 +48,9 @@ struct SlamOptions {
   // Full SLAM: after each filter update the estimate is fitted to the hits the map holds (the
   // normal-distributions transform of ndt.hpp, held near the filter's answer by `refine`'s priors),
   // and every particle moves by the same correction. The filter weighs whole cells; the fit places
-  // the scan between them.
+  // the scan between them. Not while the filter is lost or re-spread; a fit is taken only where at
+  // least a quarter of the scan's points lie on the map's hits and it moves the estimate by at most three
+  // of the priors' deviations. refine.occupied_threshold is the sensor model's.
   bool refine_estimate = false;
   NdtOptions refine;
   bool refine_shift_particles = true;
@@ -138,6 +140,7 @@ class Slam {
   const SlamOptions& options() const { return options_; }
   int64_t filter_updates() const { return filter_.updates(); }
   int64_t scans_gated() const { return scans_gated_; }
+  int64_t estimates_refined() const { return refined_; }  // refine_estimate: fits taken
 
  private:
   bool UsesFilter() const { return options_.mode != SlamMode::kMappingOnly; }
@@ -159,6 +162,7 @@ class Slam {
   std::deque<double> recent_fits_;  // the gate's history: the fits of the last scans taken
   int gated_in_row_ = 0;
   int64_t scans_gated_ = 0;
+  int64_t refined_ = 0;
 };
 
 }  // namespace mbot::mapping

@@ -20,8 +20,8 @@ struct FrontierOptions {
   // that crosses a cell: the default asks for about twenty.
   int free_threshold = -20;
   int occupied_threshold = 1;
-  // A crack (IsCrack) is a region narrower than this (0: none is).
-  double min_width_m = 0.0;
+  // A pocket (IsPocket): a small region no wider than this anywhere along it (0: none is).
+  double min_space_m = 0.0;
 };
 
 struct Frontier {
@@ -36,10 +36,12 @@ struct Frontier {
 // Sorted by size, largest first.
 std::vector<Frontier> FindFrontiers(const mapping::OccupancyGrid& map, const FrontierOptions& options);
 
-// Whether `f` is a crack in a wall narrower than options.min_width_m: no more cells than fit across
-// that width (and one), none farther than half of it from an occupied cell. The robot can neither
-// enter it nor see much through it.
-bool IsCrack(const Frontier& f, const mapping::OccupancyGrid& map, const FrontierOptions& options);
+// Whether `f` is a pocket: no more cells than fit across options.min_space_m (and one), each within
+// half of it from an occupied cell. A nook in a wall seen only at a slant, or a crack, too narrow for
+// a body that wide. (It does not look past the frontier: a short strip of free cells along one wall,
+// with open unknown beside it, counts too; the mission asks only of frontiers that stayed when seen
+// from their target.)
+bool IsPocket(const Frontier& f, const mapping::OccupancyGrid& map, const FrontierOptions& options);
 
 // What the frontier detection sees in a map, as cell centres (world frame) for a picture: cells
 // seen too faintly to count as free or occupied (between the thresholds, not unknown), and the
