@@ -21,6 +21,20 @@ int LevelsFor(double linear_m, double resolution_m) {
   return levels;
 }
 
+// Where `points` (a scan at heading `theta`) pin their position down along one direction only (a
+// corridor: weakest over strongest information below `min_ratio`; 0: never), the part of (dx, dy)
+// along the corridor, which they cannot tell: (*ax, *ay). Returns whether there is one.
+bool AlongCorridor(const std::vector<Point2>& points, double theta, double min_ratio, double dx, double dy, double* ax,
+                   double* ay) {
+  if (!(min_ratio > 0)) return false;
+  const TranslationConstraint tc = ScanTranslationConstraint(points, theta);
+  if (tc.ratio() >= min_ratio) return false;
+  const double ux = std::cos(tc.weak_axis_rad), uy = std::sin(tc.weak_axis_rad), along = dx * ux + dy * uy;
+  *ax = along * ux;
+  *ay = along * uy;
+  return true;
+}
+
 }  // namespace
 
 const MatchGrid& GraphSlam::LoopField::Get() const {
@@ -111,17 +125,14 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
     }
     const Pose2D predicted = local;
     local = RefineMatch(*s.field, *points, start, options_.refine);
-    if (options_.front_min_constraint_ratio > 0) {
-      // Where the scan cannot tell how far it moved (a corridor), the match's answer along the
-      // corridor is the map's edge, not the motion: odometry's prediction stands there.
-      const TranslationConstraint tc = ScanTranslationConstraint(*points, local.theta);
-      if (tc.ratio() < options_.front_min_constraint_ratio) {
-        const double ux = std::cos(tc.weak_axis_rad), uy = std::sin(tc.weak_axis_rad);
-        const double along = (local.x - predicted.x) * ux + (local.y - predicted.y) * uy;
-        local.x -= along * ux;
-        local.y -= along * uy;
-        ++stats_.degenerate_scans;
-      }
+    // Where the scan cannot tell how far it moved (a corridor), the match's answer along the
+    // corridor is the map's edge, not the motion: odometry's prediction stands there.
+    double ax, ay;
+    if (AlongCorridor(*points, local.theta, options_.front_min_constraint_ratio, local.x - predicted.x,
+                      local.y - predicted.y, &ax, &ay)) {
+      local.x -= ax;
+      local.y -= ay;
+      ++stats_.degenerate_scans;
     }
   }
   last_local_ = local;
@@ -261,14 +272,8 @@ ClosureCheck VerifyClosure(const MatchGrid& neighbour, const std::vector<Point2>
   // Off the search's lattice of cells, as the closure itself was.
   const Pose2D found = RefineMatch(neighbour, points, v.pose, o.refine);
   // Along a corridor neither submap can tell where the node is: only the disagreement across it counts.
-  double dx = found.x - implied.x, dy = found.y - implied.y;
-  if (o.front_min_constraint_ratio > 0) {
-    const TranslationConstraint tc = ScanTranslationConstraint(points, implied.theta);
-    if (tc.ratio() < o.front_min_constraint_ratio) {
-      const double ux = std::cos(tc.weak_axis_rad), uy = std::sin(tc.weak_axis_rad), along = dx * ux + dy * uy;
-      dx -= along * ux, dy -= along * uy;
-    }
-  }
+  double dx = found.x - implied.x, dy = found.y - implied.y, ax, ay;
+  if (AlongCorridor(points, implied.theta, o.front_min_constraint_ratio, dx, dy, &ax, &ay)) dx -= ax, dy -= ay;
   return std::hypot(dx, dy) > o.loop_verify_tolerance_m ? ClosureCheck::kContradicted : ClosureCheck::kConfirmed;
 }
 

@@ -15,27 +15,24 @@ LogOddsMapper::LogOddsMapper(const MapperOptions& options) : options_(options) {
   const int h = static_cast<int>(std::ceil(options.height_m / options.resolution_m));
   map_ = OccupancyGrid(w, h, options.resolution_m, options.center_x_m - 0.5 * w * options.resolution_m,
                        options.center_y_m - 0.5 * h * options.resolution_m);
-  if (options_.hit_moments) {
-    if (static_cast<long long>(w) * h > HitMoments::kMaxCells) {
-      throw std::invalid_argument("mapper: a grid of " + std::to_string(static_cast<long long>(w) * h) +
-                                  " cells is too large to keep hit moments for (at most " +
-                                  std::to_string(HitMoments::kMaxCells) + ")");
-    }
-    moments_.Reset(map_);
+  ResetMoments();
+}
+
+void LogOddsMapper::ResetMoments() {
+  if (!options_.hit_moments) return;
+  const long long cells = static_cast<long long>(map_.width()) * map_.height();
+  if (cells > HitMoments::kMaxCells) {
+    throw std::invalid_argument("mapper: a grid of " + std::to_string(cells) +
+                                " cells is too large to keep hit moments for (at most " +
+                                std::to_string(HitMoments::kMaxCells) + ")");
   }
+  moments_.Reset(map_);
 }
 
 void LogOddsMapper::Reset(OccupancyGrid map) {
   options_.resolution_m = map.resolution();
   map_ = std::move(map);
-  if (options_.hit_moments) {
-    if (static_cast<long long>(map_.width()) * map_.height() > HitMoments::kMaxCells) {
-      throw std::invalid_argument(
-          "mapper: a map of " + std::to_string(static_cast<long long>(map_.width()) * map_.height()) +
-          " cells is too large to keep hit moments for (at most " + std::to_string(HitMoments::kMaxCells) + ")");
-    }
-    moments_.Reset(map_);
-  }
+  ResetMoments();
 }
 
 bool LogOddsMapper::EnsureCovers(double min_x, double min_y, double max_x, double max_y) {

@@ -278,16 +278,13 @@ SlamOptions ParseSlamOptions(config::Section& s) {
     m.refine_estimate = s.GetBool("refine_estimate", m.refine_estimate,
                                   "full SLAM: fit each filter estimate to the hits the map holds (normal-distributions "
                                   "transform, between cells) and move the particles by the correction");
-    {  // read whether on or off: switching it off must not make the tuning keys unknown
-      m.refine.translation_weight = s.GetDouble("refine_translation_weight", m.refine.translation_weight,
-                                                "refine_estimate: pull towards the filter's position [1/m]", 0.0, 1e9);
-      m.refine.rotation_weight = s.GetDouble("refine_rotation_weight", m.refine.rotation_weight,
-                                             "refine_estimate: pull towards the filter's heading [1/rad]", 0.0, 1e9);
-      m.refine.min_sigma_m = s.GetDouble("refine_min_sigma_m", m.refine.min_sigma_m,
-                                         "refine_estimate: added to each cell block's spread of hits", 1e-4, 1.0);
-      m.refine_shift_particles = s.GetBool("refine_shift_particles", m.refine_shift_particles,
-                                           "refine_estimate: move the particles too (false: the estimate only)");
-    }
+    // Read whether it is on or off: switching it off must not make the tuning keys unknown.
+    m.refine.translation_weight = s.GetDouble("refine_translation_weight", m.refine.translation_weight,
+                                              "refine_estimate: pull towards the filter's position [1/m]", 0.0, 1e9);
+    m.refine.rotation_weight = s.GetDouble("refine_rotation_weight", m.refine.rotation_weight,
+                                           "refine_estimate: pull towards the filter's heading [1/rad]", 0.0, 1e9);
+    m.refine.min_sigma_m = s.GetDouble("refine_min_sigma_m", m.refine.min_sigma_m,
+                                       "refine_estimate: added to each cell block's spread of hits", 1e-4, 1.0);
   }
   // The graph keys exist in graph_slam mode only (elsewhere they are unknown keys); --list-stages
   // documents them too.

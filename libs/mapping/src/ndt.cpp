@@ -9,7 +9,7 @@
 namespace mbot::mapping {
 
 int HitMoments::DirectionOf(double angle_rad) {
-  const double a = std::atan2(std::sin(angle_rad), std::cos(angle_rad)) + M_PI;  // [0, 2π]
+  const double a = motion::WrapAngle(angle_rad) + M_PI;  // [0, 2π]
   return std::clamp(static_cast<int>(a / (2 * M_PI / kDirections)), 0, kDirections - 1);
 }
 
@@ -161,7 +161,6 @@ NdtResult RefineNdt(const OccupancyGrid& grid, const HitMoments& moments, const 
     pose.x += step(0);
     pose.y += step(1);
     pose.theta = motion::WrapAngle(pose.theta + step(2));
-    out.iterations = it + 1;
     if (std::abs(step(0)) < 1e-5 && std::abs(step(1)) < 1e-5 && std::abs(step(2)) < 1e-5) break;
   }
   out.pose = pose;

@@ -111,26 +111,8 @@ SlamStep Slam::ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2
     const ScanPoints points = model.Prepare(rays);
     const OdometryStep step = ActionModel::StepBetween(last_odometry_, odometry);
     filter_.Update(action_, step, model, points);
-    motion::Pose2D estimate = filter_.status().pose;
-    const FilterStatus& st = filter_.status();
-    if (weigh && options_.refine_estimate && st.converged && !st.lost && !st.relocalized) {
-      const std::vector<NdtPoint> hits = NdtPoints(rays);
-      const NdtResult r = RefineNdt(mapper_.map(), mapper_.moments(), hits, estimate, options_.refine);
-      // Taken where a quarter of the scan or more lies on the map's hits, and within three of the priors'
-      // deviations: a scan that does not fit (corrupt, misplaced, the world changed) moves nothing.
-      const motion::Pose2D correction = r.pose.Compose(estimate.Inverse());
-      const bool fits = hits.size() >= 10 && r.points_used >= 0.25 * hits.size();
-      const bool near =
-          std::hypot(r.pose.x - estimate.x, r.pose.y - estimate.y) * options_.refine.translation_weight <= 3.0 &&
-          std::abs(motion::WrapAngle(r.pose.theta - estimate.theta)) * options_.refine.rotation_weight <= 3.0;
-      if (fits && (near || options_.refine.translation_weight <= 0 || options_.refine.rotation_weight <= 0)) {
-        if (options_.refine_shift_particles) filter_.Shift(correction);
-        estimate = r.pose;
-        ++refined_;
-      }
-    }
     last_odometry_ = odometry;
-    last_estimate_ = estimate;
+    last_estimate_ = weigh && options_.refine_estimate ? RefineEstimate(rays) : filter_.status().pose;
     out.filter_updated = true;
   }
   out.status = filter_.status();
@@ -145,6 +127,25 @@ SlamStep Slam::ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2
     }
   }
   return out;
+}
+
+motion::Pose2D Slam::RefineEstimate(const std::vector<ScanRay>& rays) {
+  const FilterStatus& st = filter_.status();
+  const motion::Pose2D estimate = st.pose;
+  if (!st.converged || st.lost || st.relocalized) return estimate;
+  const std::vector<NdtPoint> hits = NdtPoints(rays);
+  const NdtResult r = RefineNdt(mapper_.map(), mapper_.moments(), hits, estimate, options_.refine);
+  // Taken where a quarter of the scan or more lies on the map's hits, and within three of the
+  // priors' deviations: a scan that does not fit (corrupt, misplaced, the world changed) moves nothing.
+  const NdtOptions& o = options_.refine;
+  const bool fits = hits.size() >= 10 && r.points_used >= 0.25 * hits.size();
+  const bool near = o.translation_weight <= 0 || o.rotation_weight <= 0 ||
+                    (std::hypot(r.pose.x - estimate.x, r.pose.y - estimate.y) * o.translation_weight <= 3.0 &&
+                     std::abs(motion::WrapAngle(r.pose.theta - estimate.theta)) * o.rotation_weight <= 3.0);
+  if (!fits || !near) return estimate;
+  filter_.Shift(r.pose.Compose(estimate.Inverse()));
+  ++refined_;
+  return r.pose;
 }
 
 void Slam::ResetGate() {

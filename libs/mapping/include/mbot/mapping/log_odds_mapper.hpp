@@ -46,6 +46,7 @@ class LogOddsMapper {
 
  private:
   bool EnsureCovers(double min_x, double min_y, double max_x, double max_y);
+  void ResetMoments();  // options_.hit_moments: zero moments for map_ (refused past HitMoments::kMaxCells)
 
   MapperOptions options_;
   OccupancyGrid map_;

@@ -14,7 +14,6 @@
 
 #include "mbot/mapping/moving_scan.hpp"
 #include "mbot/mapping/occupancy_grid.hpp"
-#include "mbot/mapping/scan_matching.hpp"
 #include "mbot/motion/pose2d.hpp"
 
 namespace mbot::mapping {
@@ -47,7 +46,6 @@ class HitMoments {
   const CellMoments& at(int cx, int cy, int direction) const {
     return cells_[(static_cast<size_t>(cy) * width_ + cx) * kDirections + direction];
   }
-  bool empty() const { return cells_.empty(); }
   int width() const { return width_; }
   int height() const { return height_; }
 
@@ -71,7 +69,6 @@ struct NdtOptions {
 struct NdtResult {
   motion::Pose2D pose;
   int points_used = 0;  // points with a Gaussian, at the start of the last step
-  int iterations = 0;
 };
 
 // A scan's hit in the robot frame and the direction of its ray there [rad].

@@ -19,7 +19,6 @@
 #include "mbot/mapping/moving_scan.hpp"
 #include "mbot/mapping/particle_filter.hpp"
 #include "mbot/mapping/ndt.hpp"
-#include "mbot/mapping/scan_matching.hpp"
 #include "mbot/mapping/sensor_model.hpp"
 #include "mbot/msgs/status.hpp"
 
@@ -53,7 +52,6 @@ struct SlamOptions {
   // of the priors' deviations. refine.occupied_threshold is the sensor model's.
   bool refine_estimate = false;
   NdtOptions refine;
-  bool refine_shift_particles = true;
 };
 
 struct SlamStep {
@@ -145,6 +143,8 @@ class Slam {
  private:
   bool UsesFilter() const { return options_.mode != SlamMode::kMappingOnly; }
   bool Gate(const std::vector<ScanRay>& rays, const motion::Pose2D& pose);
+  // refine_estimate: the filter's estimate fitted to the map's hits, the particles moved with it.
+  motion::Pose2D RefineEstimate(const std::vector<ScanRay>& rays);
   void ResetGate();  // a map cleared or switched: the recent fits say nothing of the next
 
   SlamOptions options_;
