@@ -120,6 +120,7 @@ async function extras(page) {
   await frames(2);
   const withoutDistances = await orange();
   await page.click("#show_distances");
+  const ticked = await page.$eval("#show_distances", (e) => e.checked);
   await frames(2);
   const withDistances = await orange();
   const held = await page.evaluate(() => {
@@ -130,6 +131,7 @@ async function extras(page) {
     for (let i = 0; i < b.length; ++i) { const cm = b.charCodeAt(i); if (cm > 0 && cm < 50) ++tinted; }
     return { tinted, cells: b.length, t: d.timestamp };
   });
+  check(ticked, "the obstacle distance box ticked by a click");
   check(haveDistances && withDistances.free < 0.7 * withoutDistances.free,
         `obstacle distances drawn when asked (white free space ${withoutDistances.free} -> ${withDistances.free} px; ` +
         `grid ${held.cells} cells, ${held.tinted} within 0.5 m of a wall)`);
