@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "mbot/mapping/scan_perturbation.hpp"
 #include "mbot/mapping/slam.hpp"
 
 namespace mbot::mapping {
@@ -98,6 +99,88 @@ TEST(DeskewScan, ShortAndMissingReturnsClearNothingOrAreMisses) {
   for (const ScanRay& r : rays) (r.hit ? hits : misses)++;
   EXPECT_EQ(hits, 1);    // 2.0 m
   EXPECT_LE(misses, 1);  // 6.0 m beyond max_range_m clears as a miss; too short and no return are dropped
+}
+
+// A return at the sensor's own maximum is no return (glass, the open), not a measured distance:
+// it clears only no_return_clear_m. A return beyond our cap but short of the sensor's maximum was
+// measured, and clears up to the cap.
+TEST(DeskewScan, TheSensorsMaximumIsNoReturn) {
+  ScanOptions o;
+  o.max_range_m = 30.0;
+  std::vector<ScanRay> rays = DeskewScan({81.0f, 40.0f}, {0, 0}, {}, {}, {}, 81.0, o);
+  ASSERT_EQ(rays.size(), 1u);  // 81 m dropped; 40 m clears 30 m
+  EXPECT_FALSE(rays[0].hit);
+  EXPECT_NEAR(rays[0].ex, 30.0f, 1e-4);
+  o.no_return_clear_m = 2.0;
+  rays = DeskewScan({81.0f}, {0}, {}, {}, {}, 81.0, o);
+  ASSERT_EQ(rays.size(), 1u);
+  EXPECT_FALSE(rays[0].hit);
+  EXPECT_NEAR(rays[0].ex, 2.0f, 1e-4);
+}
+
+// Glass: with every wall patch glass, every return goes through (no return at the sensor's maximum,
+// or a return 1.5-3 times as far), about half each way; with none, nothing changes.
+TEST(ScanPerturbation, GlassSendsReturnsThroughOrBeyond) {
+  const std::vector<float> angles = Revolution(360);
+  std::vector<float> ranges(360, 2.0f);
+  ScanPerturbationOptions o;
+  o.glass_share = 1.0;
+  ScanPerturbation glass(o, 7);
+  glass.Apply(1'000'000, {}, angles, 10.0, &ranges);
+  int through = 0, beyond = 0;
+  for (float r : ranges) {
+    if (r == 10.0f) {
+      ++through;
+    } else {
+      ++beyond;
+      EXPECT_GE(r, 3.0f);
+      EXPECT_LE(r, 6.0f);
+    }
+  }
+  EXPECT_EQ(glass.glass_beams(), 360);
+  EXPECT_GT(through, 120);
+  EXPECT_GT(beyond, 120);
+  std::vector<float> clear(360, 2.0f);
+  o.glass_share = 0.0;
+  o.people = 0;
+  ScanPerturbation none(o, 7);
+  EXPECT_FALSE(o.any());
+  none.Apply(1'000'000, {}, angles, 10.0, &clear);
+  EXPECT_EQ(clear, std::vector<float>(360, 2.0f));
+}
+
+// People: inside a 5 m ring of wall, a person 0.8-4 m away hides a few degrees of it at their
+// distance (under 5 m), moves at walking speed between scans, and the same seed draws the same
+// people.
+TEST(ScanPerturbation, PeopleHideTheWallAndWalk) {
+  const std::vector<float> angles = Revolution(720);
+  ScanPerturbationOptions o;
+  o.people = 1;
+  ScanPerturbation a(o, 3), b(o, 3);
+  auto hidden = [&](ScanPerturbation& p, int64_t t_us, std::vector<float>* ranges) {
+    ranges->assign(720, 5.0f);
+    p.Apply(t_us, {}, angles, 10.0, ranges);
+    std::vector<int> beams;
+    for (int i = 0; i < 720; ++i) {
+      if ((*ranges)[i] < 5.0f) {
+        EXPECT_GE((*ranges)[i], 0.6f);
+        EXPECT_LE((*ranges)[i], 4.0f);
+        beams.push_back(i);
+      }
+    }
+    return beams;
+  };
+  std::vector<float> r1, r2, r3;
+  const std::vector<int> first = hidden(a, 0, &r1);
+  ASSERT_GE(first.size(), 5u);   // 0.4 m wide at <= 4 m: >= 5.7 degrees, 11 beams of 0.5
+  ASSERT_LE(first.size(), 60u);  // at >= 0.8 m: <= 29 degrees
+  EXPECT_EQ(hidden(b, 0, &r2), first);
+  EXPECT_EQ(r1, r2);
+  // 0.2 s later the person has walked 0.2 m: the nearest range or the hidden beams changed.
+  const std::vector<int> later = hidden(a, 200'000, &r3);
+  ASSERT_FALSE(later.empty());
+  EXPECT_TRUE(later != first || r3 != r1);
+  EXPECT_EQ(a.person_beams(), static_cast<long long>(first.size() + later.size()));
 }
 
 // Range smoothing: along a wall 1 m ahead measured with ±2 cm of alternating noise, each return

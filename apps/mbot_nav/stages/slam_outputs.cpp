@@ -76,6 +76,10 @@ void WriteSlamOutputs(const RunContext& ctx, bool interrupted, const SlamStageOp
   j["scans"] = records.records();
   j["scans_skipped"] = session.skipped_scans();
   j["scans_gated"] = session.slam().scans_gated();
+  if (options.session.scan_perturbation.any()) {
+    j["injected"]["glass_beams"] = session.scan_perturbation().glass_beams();
+    j["injected"]["person_beams"] = session.scan_perturbation().person_beams();
+  }
   j["filter_updates"] = updates;
   j["particles"] = options.session.slam.filter.particles;
   const bool any_truth =

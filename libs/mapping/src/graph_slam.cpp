@@ -105,10 +105,12 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
               s.grid->map(), options_.field_sigma_m, options_.occupied_threshold,
               LevelsFor(options_.recover_window.linear_m, options_.submap.resolution_m));
         }
-        // Taken only where it fits as scans usually do: else the local answer stands.
+        // Taken only where it fits as scans usually do, and clearly better than the local answer:
+        // else that stands.
+        const double margin = std::max(options_.recover_margin * mean_score_, 1e-6);
         const MatchResult w =
             MatchBranchAndBound(*s.wide, *points, local, options_.recover_window,
-                                std::max(m.found ? m.score + 1e-6 : 0.0, options_.recover_below * mean_score_));
+                                std::max(m.found ? m.score + margin : 0.0, options_.recover_below * mean_score_));
         if (w.found) {
           m = w;
           ++stats_.recoveries;

@@ -183,6 +183,10 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
                         "front end: an odometry gap longer than this around a scan, or a zeroed restart, searches the "
                         "recovery window whatever the fit scored (0: never)",
                         0.0, 3600.0);
+  g.recover_margin = num("recover_margin", g.recover_margin,
+                         "front end: a recovery is taken only where it scores this share of the running mean score "
+                         "above the local fit",
+                         0.0, 1.0);
   window("recover_window", &g.recover_window, "front end: recovery", 20.0);
   g.front_min_constraint_ratio =
       num("front_min_constraint_ratio", g.front_min_constraint_ratio,

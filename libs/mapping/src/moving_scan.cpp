@@ -27,7 +27,11 @@ std::vector<ScanRay> DeskewScan(const std::vector<float>& ranges, const std::vec
     }
     double length;
     bool hit;
-    if (!std::isfinite(r) || r <= 0.0) {  // no return
+    // No return: none measured, or the sensor's own maximum (what a SICK reports through glass or
+    // into the open; REP 117's out-of-range). Such a beam clears no_return_clear_m, not the whole
+    // range: through a pane it would wipe out the walls behind (Intel with a fifth of its walls made
+    // glass: 0.0186 m when those beams clear nothing, 1.41 m when they clear 30 m).
+    if (!std::isfinite(r) || r <= 0.0 || (sensor_max_range_m > 0 && r >= sensor_max_range_m)) {
       if (options.no_return_clear_m <= 0) continue;
       length = options.no_return_clear_m;
       hit = false;

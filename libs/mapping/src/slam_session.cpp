@@ -102,6 +102,13 @@ SlamSessionOptions ParseSlamSessionOptions(config::Section& s) {
   pert.jump_max_rad = s.GetDouble("odometry_jump_max_rad", 0.0, "... and up to this turn, either way", 0.0, M_PI);
   o.scan_every = static_cast<int>(s.GetInt(
       "scan_every", 1, "use every k-th scan of the lidar channel (others dropped: robustness tests)", 1, 1000));
+  auto& scan_pert = o.scan_perturbation;
+  scan_pert.glass_share = s.GetDouble("scan_glass_share", 0.0,
+                                      "injected glass: the share of the walls (in 1 m patches fixed in the odometry "
+                                      "frame) a beam goes through, to no return or a return 1.5-3 times as far",
+                                      0.0, 1.0);
+  scan_pert.people = static_cast<int>(s.GetInt(
+      "scan_people", 0, "injected people: this many 0.2 m discs walking at 1 m/s within 4 m of the lidar", 0, 100));
 
   o.particles_every = static_cast<int>(
       s.GetInt("particles_every", o.particles_every, "draw the particles every k-th scan (0: never)", 0));
@@ -295,7 +302,8 @@ SlamSession::SlamSession(const SlamSessionOptions& options, uint64_t seed, std::
       slam_(options.slam, seed),
       inputs_(options, seed),
       events_(options.slam.filter.lost_inlier_fraction),
-      consistency_model_(options.slam.sensor) {
+      consistency_model_(options.slam.sensor),
+      scan_perturbation_(options.scan_perturbation, seed) {
   if (known_map && options.slam.mode == SlamMode::kGraphSlam) {
     global_map_ = std::move(known_map);
   } else if (known_map) {
@@ -369,10 +377,15 @@ void SlamSession::ProcessScan(const SlamInputs::Scan& p, int64_t t_end, std::vec
     return;
   }
   const Pose2D sensor = o_.lidar_pose_from_scan ? scan.sensor_pose : o_.lidar_pose;
+  std::vector<float> perturbed;
+  if (o_.scan_perturbation.any()) {
+    perturbed = scan.ranges_m;
+    scan_perturbation_.Apply(t_end, end_pose.Compose(sensor), scan.angles_rad, scan.max_range_m, &perturbed);
+  }
   const auto wall0 = std::chrono::steady_clock::now();
   const std::vector<ScanRay> rays =
-      DeskewScan(scan.ranges_m, scan.angles_rad, fractions, end_pose.Inverse().Compose(start_pose), sensor,
-                 scan.max_range_m, o_.scan);
+      DeskewScan(o_.scan_perturbation.any() ? perturbed : scan.ranges_m, scan.angles_rad, fractions,
+                 end_pose.Inverse().Compose(start_pose), sensor, scan.max_range_m, o_.scan);
   if (!slam_.initialized() && !Initialize(t_end, end_pose, rays)) {
     ++skipped_scans_;
     return;

@@ -18,6 +18,7 @@
 
 #include "mbot/common/strided_sample.hpp"
 #include "mbot/mapping/moving_scan.hpp"
+#include "mbot/mapping/scan_perturbation.hpp"
 #include "mbot/mapping/slam.hpp"
 #include "mbot/motion/odometry_continuity.hpp"
 #include "mbot/motion/odometry_perturbation.hpp"
@@ -54,7 +55,8 @@ struct SlamSessionOptions {
   double checkpoint_every_s = 0.0;                // 0: no checkpoints
   // Perturbations for robustness tests.
   motion::OdometryPerturbationOptions perturbation;
-  int scan_every = 1;  // use every k-th scan (robustness tests drop the others)
+  int scan_every = 1;                         // use every k-th scan (robustness tests drop the others)
+  ScanPerturbationOptions scan_perturbation;  // glass and people
   // What is published, and kept for pictures.
   int particles_every = 0;          // keep the particles every k-th scan, for the map picture (0: never)
   int publish_particles_every = 0;  // emit SLAM_PARTICLES every k-th scan (0: never)
@@ -204,6 +206,7 @@ class SlamSession {
   const std::vector<ScanSample::Item>& scan_points() const { return scan_sample_.items(); }
   const std::vector<motion::Pose2D>& particle_snapshots() const { return particle_snapshots_; }
   int skipped_scans() const { return skipped_scans_; }
+  const ScanPerturbation& scan_perturbation() const { return scan_perturbation_; }
 
  private:
   void ProcessReadyScans(bool at_end, std::vector<msgs::Event>* out);
@@ -220,6 +223,7 @@ class SlamSession {
   SlamInputs inputs_;
   SlamEventTracker events_;
   SensorModel consistency_model_;
+  ScanPerturbation scan_perturbation_;
   ScanSample scan_sample_{2048};  // the map-consistency metric's scans: bounded for any run length
   std::deque<ScanRecord> records_;
   size_t paired_truth_ = 0, paired_reference_ = 0;  // records before these have their truth / reference
