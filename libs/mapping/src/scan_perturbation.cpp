@@ -14,6 +14,8 @@ uint64_t Mix(uint64_t z) {
   return z ^ (z >> 31);
 }
 
+constexpr double kGlassPatchM = 1.0;
+constexpr double kPersonRadiusM = 0.2, kPersonSpeedMS = 1.0;
 constexpr double kNearestPersonM = 0.8, kFarthestPersonM = 4.0;  // where a person starts, from the sensor
 constexpr double kShortestWalkS = 2.0, kLongestWalkS = 6.0;
 
@@ -23,8 +25,8 @@ ScanPerturbation::ScanPerturbation(const ScanPerturbationOptions& options, uint6
     : o_(options), seed_(Mix(seed ^ 0x676c617373ULL)), rng_(seed ^ 0x70656f706c65ULL), people_(options.people) {}
 
 bool ScanPerturbation::Glass(double x, double y) const {
-  const auto cx = static_cast<int64_t>(std::floor(x / o_.glass_patch_m));
-  const auto cy = static_cast<int64_t>(std::floor(y / o_.glass_patch_m));
+  const auto cx = static_cast<int64_t>(std::floor(x / kGlassPatchM));
+  const auto cy = static_cast<int64_t>(std::floor(y / kGlassPatchM));
   const uint64_t h = Mix(seed_ ^ Mix(static_cast<uint64_t>(cx) * 0x9e3779b97f4a7c15ULL + static_cast<uint64_t>(cy)));
   return static_cast<double>(h >> 11) * 0x1.0p-53 < o_.glass_share;
 }
@@ -35,8 +37,8 @@ void ScanPerturbation::Place(Person* p, int64_t t_us, const motion::Pose2D& sens
   const double heading = 2 * M_PI * u(rng_);
   p->x = sensor.x + d * std::cos(bearing);
   p->y = sensor.y + d * std::sin(bearing);
-  p->vx = o_.person_speed_m_s * std::cos(heading);
-  p->vy = o_.person_speed_m_s * std::sin(heading);
+  p->vx = kPersonSpeedMS * std::cos(heading);
+  p->vy = kPersonSpeedMS * std::sin(heading);
   p->until_us = t_us + static_cast<int64_t>((kShortestWalkS + (kLongestWalkS - kShortestWalkS) * u(rng_)) * 1e6);
 }
 
@@ -44,7 +46,7 @@ void ScanPerturbation::Apply(int64_t t_us, const motion::Pose2D& sensor, const s
                              double max_range_m, std::vector<float>* ranges) {
   const double dt = last_us_ >= 0 && t_us > last_us_ ? (t_us - last_us_) * 1e-6 : 0.0;
   last_us_ = t_us;
-  const double r2 = o_.person_radius_m * o_.person_radius_m;
+  const double r2 = kPersonRadiusM * kPersonRadiusM;
   for (Person& p : people_) {
     p.x += p.vx * dt, p.y += p.vy * dt;
     const double dx = p.x - sensor.x, dy = p.y - sensor.y;

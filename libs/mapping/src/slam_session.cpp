@@ -377,15 +377,16 @@ void SlamSession::ProcessScan(const SlamInputs::Scan& p, int64_t t_end, std::vec
     return;
   }
   const Pose2D sensor = o_.lidar_pose_from_scan ? scan.sensor_pose : o_.lidar_pose;
+  const std::vector<float>* ranges = &scan.ranges_m;
   std::vector<float> perturbed;
   if (o_.scan_perturbation.any()) {
     perturbed = scan.ranges_m;
     scan_perturbation_.Apply(t_end, end_pose.Compose(sensor), scan.angles_rad, scan.max_range_m, &perturbed);
+    ranges = &perturbed;
   }
   const auto wall0 = std::chrono::steady_clock::now();
-  const std::vector<ScanRay> rays =
-      DeskewScan(o_.scan_perturbation.any() ? perturbed : scan.ranges_m, scan.angles_rad, fractions,
-                 end_pose.Inverse().Compose(start_pose), sensor, scan.max_range_m, o_.scan);
+  const std::vector<ScanRay> rays = DeskewScan(
+      *ranges, scan.angles_rad, fractions, end_pose.Inverse().Compose(start_pose), sensor, scan.max_range_m, o_.scan);
   if (!slam_.initialized() && !Initialize(t_end, end_pose, rays)) {
     ++skipped_scans_;
     return;

@@ -1,12 +1,12 @@
 // Scans made worse on purpose, for robustness tests of SLAM on real logs (issue 31): what a building
 // does to a lidar that the recorded data lacks.
-//  - Glass: a share of the walls, in square patches fixed in the odometry frame, is glass. A beam
-//    that ends on a glass patch goes through it: half of those give no return at all (the range is
-//    the sensor's maximum, which clears the map along the whole beam), the others a return from
-//    1.5-3 times as far (something behind the pane; the map gains an obstacle where there is none).
-//  - People: discs of a person's size walk straight at walking speed near the robot, a few seconds
-//    each, and are drawn into every beam that meets them before its own return; the map sees moving
-//    obstacles, and the walls they hide are missing from those scans.
+//  - Glass: a share of the walls, in 1 m patches fixed in the odometry frame, is glass. A beam that
+//    ends on a pane goes through it: half of those give no return (the sensor's maximum, as a SICK
+//    reports it), the others a return from 1.5-3 times as far (something behind the pane; the map
+//    gains an obstacle where there is none).
+//  - People: 0.4 m discs walk straight at 1 m/s, 0.8-4 m from the lidar, 2-6 s each, and are drawn
+//    into every beam that meets them before its own return; the map sees moving obstacles, and the
+//    walls they hide are missing from those scans.
 // Seeded: the same seed and scans give the same perturbed ranges.
 #pragma once
 
@@ -20,10 +20,7 @@ namespace mbot::mapping {
 
 struct ScanPerturbationOptions {
   double glass_share = 0.0;  // share of the wall patches that are glass (0: none)
-  double glass_patch_m = 1.0;
-  int people = 0;  // people walking about the robot at any time
-  double person_radius_m = 0.2;
-  double person_speed_m_s = 1.0;
+  int people = 0;            // people walking about the robot at any time
   bool any() const { return glass_share > 0 || people > 0; }
 };
 
