@@ -468,6 +468,25 @@ TEST(LoopSearchWindow, GrowsWithThePathUpToTheLoopWindow) {
   EXPECT_DOUBLE_EQ(LoopSearchWindow(o, 1.0, false).angular_rad, 0.35);
 }
 
+// The recovery window's law: where the odometry is not doubtful, its step plus the slack (never
+// below the local window, never beyond the recovery window); doubtful odometry or a slack of 0
+// searches the whole recovery window.
+TEST(RecoverySearchWindow, ReachesTheOdometrysStepPlusTheSlack) {
+  GraphSlamOptions o;
+  o.local_window = {0.1, 0.2, 0.005};
+  o.recover_window = {1.5, 0.5, 0.005};
+  o.recover_slack_m = 0.3;
+  EXPECT_DOUBLE_EQ(RecoverySearchWindow(o, 0.05, false).linear_m, 0.35);
+  EXPECT_DOUBLE_EQ(RecoverySearchWindow(o, 0.05, false).angular_rad, 0.5);
+  EXPECT_DOUBLE_EQ(RecoverySearchWindow(o, 0.8, false).linear_m, 1.1);
+  EXPECT_DOUBLE_EQ(RecoverySearchWindow(o, 3.0, false).linear_m, 1.5);
+  EXPECT_DOUBLE_EQ(RecoverySearchWindow(o, 0.05, true).linear_m, 1.5);
+  o.recover_slack_m = 0.01;
+  EXPECT_DOUBLE_EQ(RecoverySearchWindow(o, 0.0, false).linear_m, 0.1);
+  o.recover_slack_m = 0;
+  EXPECT_DOUBLE_EQ(RecoverySearchWindow(o, 0.05, false).linear_m, 1.5);
+}
+
 // The measure itself: a room's scan faces every way, a corridor's across it only, whatever the
 // scan's heading; the weak axis comes out along the corridor in the map's frame.
 TEST(ScanTranslationConstraint, TellsACorridorFromARoom) {

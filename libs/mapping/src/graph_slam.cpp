@@ -108,9 +108,13 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
         // Taken only where it fits as scans usually do, and clearly better than the local answer:
         // else that stands.
         const double margin = std::max(options_.recover_margin * mean_score_, 1e-6);
+        const double need = std::max(m.found ? m.score + margin : 0.0, options_.recover_below * mean_score_);
+        // No farther than the odometry's step can have been wrong (the whole window where the
+        // odometry itself is doubtful).
+        const Pose2D step = last_odometry_.Inverse().Compose(odometry);
         const MatchResult w =
-            MatchBranchAndBound(*s.wide, *points, local, options_.recover_window,
-                                std::max(m.found ? m.score + margin : 0.0, options_.recover_below * mean_score_));
+            MatchBranchAndBound(*s.wide, *points, local,
+                                RecoverySearchWindow(options_, std::hypot(step.x, step.y), odometry_doubtful), need);
         if (w.found) {
           m = w;
           ++stats_.recoveries;
@@ -288,6 +292,13 @@ SearchWindow LoopSearchWindow(const GraphSlamOptions& o, double path_m, bool dou
   if (o.loop_drift_rad_per_m > 0) {
     w.angular_rad = std::min(w.angular_rad, o.local_window.angular_rad + o.loop_drift_rad_per_m * path_m);
   }
+  return w;
+}
+
+SearchWindow RecoverySearchWindow(const GraphSlamOptions& o, double odometry_step_m, bool doubtful) {
+  SearchWindow w = o.recover_window;
+  if (doubtful || o.recover_slack_m <= 0) return w;
+  w.linear_m = std::min(w.linear_m, std::max(o.local_window.linear_m, odometry_step_m + o.recover_slack_m));
   return w;
 }
 

@@ -187,6 +187,10 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
                          "front end: a recovery is taken only where it scores this share of the running mean score "
                          "above the local fit",
                          0.0, 1.0);
+  g.recover_slack_m = num("recover_slack_m", g.recover_slack_m,
+                          "front end: where the odometry is not doubtful, a recovery searches no farther from the "
+                          "prediction than the odometry's step plus this (0: the whole recovery window)",
+                          0.0, 20.0);
   window("recover_window", &g.recover_window, "front end: recovery", 20.0);
   g.front_min_constraint_ratio =
       num("front_min_constraint_ratio", g.front_min_constraint_ratio,
