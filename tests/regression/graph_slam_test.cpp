@@ -567,10 +567,10 @@ TEST(GraphSlamRegression, IntelWithGlassAndPeopleStaysWithinBounds) {
 // a look-alike place 1.6 m away fitted better (by more than the 0.15 margin of then): the robot
 // jumped there on an odometry step of 8 cm and back on the next scan. A glitch is part of the odometry's own step, so
 // where the odometry is not doubtful the recovery searches no farther than that step plus
-// graph_recover_slack_m (0.3 m). Without that bound this slice scored 0.0600 m (largest 1.52 m); with
-// it 0.0456 m (largest 0.37 m); clean 0.0370 m and 0.26 deg (2026-12-05). Seeds 2 and 3: 0.0415 and
-// 0.0446 m (largest 0.21 and 0.24 m), against 0.0493 (1.32) and 0.0446 (0.24) before the bound (with
-// the 0.15 margin of then).
+// graph_recover_slack_m (0.3 m). Without that bound this slice scored 0.0600 m (largest 1.52 m), and
+// 0.0592 m with the 0.15 margin of before; with it 0.0456 m (largest 0.37 m); clean 0.0370 m and
+// 0.26 deg (2026-12-05). Seeds 2 and 3: 0.0415 and 0.0446 m (largest 0.21 and 0.24 m), against
+// 0.0493 (1.32) and 0.0446 (0.24) before the bound, with the margin.
 TEST(GraphSlamRegression, AcesWithGlassAndPeopleStaysWithinBounds) {
   const std::vector<std::string> sets = {"source.path=" + Data("carmen/aces-raw.clf.gz"),
                                          "slam.relations=" + Data("carmen/aces.relations"),

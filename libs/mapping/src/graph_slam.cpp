@@ -67,6 +67,7 @@ void GraphSlam::Initialize(const Pose2D& pose, const Pose2D& odometry) {
   correction_ = pose;  // the front end's frame starts at the identity
   last_local_ = Pose2D{};
   last_odometry_ = odometry;
+  unmatched_m_ = 0;
   initialized_ = true;
 }
 
@@ -74,7 +75,12 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
   if (!initialized_) throw std::logic_error("graph SLAM: ProcessScan before Initialize");
   MaybeApplyFinished();
   const auto t0 = Clock::now();
-  Pose2D local = last_local_.Compose(last_odometry_.Inverse().Compose(odometry));
+  const Pose2D step = last_odometry_.Inverse().Compose(odometry);
+  Pose2D local = last_local_.Compose(step);
+  // The odometry's motion since the last scan that was matched: a glitch on a scan too sparse to
+  // match is still within reach of the next one's recovery search.
+  const double unmatched_m = unmatched_m_ + std::hypot(step.x, step.y);
+  bool matched = false;
   auto points = std::make_shared<const std::vector<Point2>>(ScanHitPoints(rays, options_.point_spacing_m));
   ++stats_.scans;
   if (odometry_doubtful) ++doubtful_seen_;
@@ -105,16 +111,13 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
               s.grid->map(), options_.field_sigma_m, options_.occupied_threshold,
               LevelsFor(options_.recover_window.linear_m, options_.submap.resolution_m));
         }
-        // Taken only where it fits as scans usually do, and clearly better than the local answer:
-        // else that stands.
+        // Taken only where it fits as scans usually do, and better than the local answer (by
+        // recover_margin of the mean): else that stands. No farther than the odometry since the
+        // last matched scan can have been wrong (the whole window where it is doubtful).
         const double margin = std::max(options_.recover_margin * mean_score_, 1e-6);
         const double need = std::max(m.found ? m.score + margin : 0.0, options_.recover_below * mean_score_);
-        // No farther than the odometry's step can have been wrong (the whole window where the
-        // odometry itself is doubtful).
-        const Pose2D step = last_odometry_.Inverse().Compose(odometry);
-        const MatchResult w =
-            MatchBranchAndBound(*s.wide, *points, local,
-                                RecoverySearchWindow(options_, std::hypot(step.x, step.y), odometry_doubtful), need);
+        const MatchResult w = MatchBranchAndBound(*s.wide, *points, local,
+                                                  RecoverySearchWindow(options_, unmatched_m, odometry_doubtful), need);
         if (w.found) {
           m = w;
           ++stats_.recoveries;
@@ -122,6 +125,7 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
           ++doubtful_seen_;
         }
       }
+      matched = m.found;
       if (m.found) {
         start = m.pose;
         // A slow running mean (about the last hundred scans).
@@ -143,6 +147,7 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
   }
   last_local_ = local;
   last_odometry_ = odometry;
+  unmatched_m_ = matched ? 0.0 : unmatched_m;
   bool make_node = nodes_.empty();
   if (!make_node && !sparse) {
     const Pose2D moved = nodes_.back().local.Inverse().Compose(local);

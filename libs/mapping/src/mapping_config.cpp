@@ -185,7 +185,7 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
                         0.0, 3600.0);
   g.recover_margin = num("recover_margin", g.recover_margin,
                          "front end: a recovery is taken only where it scores this share of the running mean score "
-                         "above the local fit",
+                         "above the local fit (0: any better fit)",
                          0.0, 1.0);
   g.recover_slack_m = num("recover_slack_m", g.recover_slack_m,
                           "front end: where the odometry is not doubtful, a recovery searches no farther from the "

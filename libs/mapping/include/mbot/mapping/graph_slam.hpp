@@ -57,8 +57,9 @@ struct GraphSlamOptions {
   // on the made-harder Intel slice (0.0200 against 0.0289 m). The bound below keeps those jumps out.
   double recover_margin = 0.0;
   // A glitch is part of the odometry's own step: where the odometry is not doubtful, a recovery
-  // searches no farther from the prediction than that step plus this slack (the motion the step may
-  // have missed), never beyond recover_window. The made-harder slices' true recoveries moved the
+  // searches no farther from the prediction (± in x and y) than that step plus this slack (the
+  // motion the step may have missed), never beyond recover_window; the steps of scans too sparse to
+  // match count too. The made-harder slices' true recoveries moved the
   // scan at most 0.17 m more than the glitched step; with people walking by and glass, wrong ones
   // moved it 1.0-1.7 m on steps of under 0.1 m (0: recover_window always).
   double recover_slack_m = 0.3;
@@ -108,9 +109,10 @@ struct GraphSlamOptions {
 // grown by the drift rates times the path, never beyond loop_window.
 SearchWindow LoopSearchWindow(const GraphSlamOptions& options, double path_m, bool doubtful);
 
-// The window a recovery search covers after an odometry step of `odometry_step_m` (`doubtful`: a
-// gap or a zeroed restart around it): recover_window, narrowed where the odometry is not doubtful
-// to that step plus recover_slack_m (never below the local window).
+// The window a recovery search covers after `odometry_step_m` of odometry since the last matched
+// scan (`doubtful`: a gap or a zeroed restart around it): recover_window, narrowed where the
+// odometry is not doubtful to ± that length plus recover_slack_m in x and y (never below the local
+// window).
 SearchWindow RecoverySearchWindow(const GraphSlamOptions& options, double odometry_step_m, bool doubtful);
 
 // A closure checked in a neighbouring finished submap: the node searched there (loop_verify_window,
@@ -261,6 +263,7 @@ class GraphSlam {
   motion::Pose2D last_odometry_, last_local_;
   motion::Pose2D correction_;  // global ⊕ local⁻¹, from the last solve
   double mean_score_ = 0;      // running mean of the front end's match scores
+  double unmatched_m_ = 0;     // odometry path since the last scan the front end matched
   int scores_ = 0;
   bool odometry_doubtful_ = false;  // a recovery since the last node
   int doubtful_seen_ = 0;           // recoveries and doubtful odometry steps so far
