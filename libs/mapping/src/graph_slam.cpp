@@ -300,10 +300,10 @@ SearchWindow LoopSearchWindow(const GraphSlamOptions& o, double path_m, bool dou
   return w;
 }
 
-SearchWindow RecoverySearchWindow(const GraphSlamOptions& o, double odometry_step_m, bool doubtful) {
+SearchWindow RecoverySearchWindow(const GraphSlamOptions& o, double unmatched_m, bool doubtful) {
   SearchWindow w = o.recover_window;
   if (doubtful || o.recover_slack_m <= 0) return w;
-  w.linear_m = std::min(w.linear_m, std::max(o.local_window.linear_m, odometry_step_m + o.recover_slack_m));
+  w.linear_m = std::min(w.linear_m, std::max(o.local_window.linear_m, unmatched_m + o.recover_slack_m));
   return w;
 }
 

@@ -189,7 +189,8 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
                          0.0, 1.0);
   g.recover_slack_m = num("recover_slack_m", g.recover_slack_m,
                           "front end: where the odometry is not doubtful, a recovery searches no farther from the "
-                          "prediction than the odometry's step plus this (0: the whole recovery window)",
+                          "prediction than the odometry since the last matched scan plus this (0: the whole "
+                          "recovery window)",
                           0.0, 20.0);
   window("recover_window", &g.recover_window, "front end: recovery", 20.0);
   g.front_min_constraint_ratio =

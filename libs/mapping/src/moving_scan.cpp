@@ -14,13 +14,10 @@ std::vector<ScanRay> DeskewScan(const std::vector<float>& ranges, const std::vec
   rays.reserve(ranges.size());
   const motion::Pose2D identity;
   const int n = static_cast<int>(ranges.size());
-  // No return: none measured, or the sensor's own maximum (what a SICK reports through glass or into
-  // the open; REP 117's out-of-range). Such a beam clears no_return_clear_m, not the whole range:
-  // through a pane it would wipe out the walls behind (Intel with a fifth of its walls made glass:
-  // 0.0186 m when those beams clear nothing, 1.41 m when they clear 30 m).
-  const auto no_return = [&](double r) {
-    return !std::isfinite(r) || r <= 0.0 || (sensor_max_range_m > 0 && r >= sensor_max_range_m);
-  };
+  // A beam with no return (IsNoReturn) clears no_return_clear_m, not the whole range: through a pane
+  // it would wipe out the walls behind (Intel with a fifth of its walls made glass: 0.0186 m when
+  // those beams clear nothing, 1.41 m when they clear 30 m).
+  const auto no_return = [&](double r) { return IsNoReturn(r, sensor_max_range_m); };
   const auto valid = [&](int j) { return !no_return(ranges[j]) && ranges[j] >= options.min_range_m; };
   for (int i = 0; i < n; ++i) {
     double r = ranges[i];

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "mbot/mapping/moving_scan.hpp"
+
 namespace mbot::mapping {
 
 namespace {
@@ -61,8 +63,7 @@ void ScanPerturbation::Apply(int64_t t_us, const motion::Pose2D& sensor, const s
   for (size_t i = 0; i < n; ++i) {
     float& range = (*ranges)[i];
     const double a = sensor.theta + angles[i], c = std::cos(a), s = std::sin(a);
-    const bool returned = std::isfinite(range) && range > 0 && (max_range_m <= 0 || range < max_range_m);
-    if (o_.glass_share > 0 && returned && Glass(sensor.x + range * c, sensor.y + range * s)) {
+    if (o_.glass_share > 0 && !IsNoReturn(range, max_range_m) && Glass(sensor.x + range * c, sensor.y + range * s)) {
       ++glass_beams_;
       if (u(rng_) < 0.5) {
         range = max_range_m > 0 ? static_cast<float>(max_range_m) : std::numeric_limits<float>::quiet_NaN();
@@ -81,8 +82,7 @@ void ScanPerturbation::Apply(int64_t t_us, const motion::Pose2D& sensor, const s
       if (across2 >= r2) continue;
       nearest = std::min(nearest, along - std::sqrt(r2 - across2));
     }
-    const bool far = !std::isfinite(range) || range <= 0 || (max_range_m > 0 && range >= max_range_m);
-    if (std::isfinite(nearest) && (far || nearest < range)) {
+    if (std::isfinite(nearest) && (IsNoReturn(range, max_range_m) || nearest < range)) {
       range = static_cast<float>(nearest);
       ++person_beams_;
     }

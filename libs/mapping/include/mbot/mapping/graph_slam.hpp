@@ -59,9 +59,9 @@ struct GraphSlamOptions {
   // A glitch is part of the odometry's own step: where the odometry is not doubtful, a recovery
   // searches no farther from the prediction (± in x and y) than that step plus this slack (the
   // motion the step may have missed), never beyond recover_window; the steps of scans too sparse to
-  // match count too. The made-harder slices' true recoveries moved the
-  // scan at most 0.17 m more than the glitched step; with people walking by and glass, wrong ones
-  // moved it 1.0-1.7 m on steps of under 0.1 m (0: recover_window always).
+  // match count too. The made-harder slices' true recoveries moved the scan at most 0.17 m more than
+  // the glitched step; with people walking by and glass, wrong ones moved it 1.0-1.7 m on steps of
+  // under 0.1 m (0: recover_window always).
   double recover_slack_m = 0.3;
   // A scan that cannot pin its position down along a direction (its surfaces' weakest information
   // below this share of their strongest, ScanTranslationConstraint: a corridor) keeps odometry's
@@ -109,11 +109,10 @@ struct GraphSlamOptions {
 // grown by the drift rates times the path, never beyond loop_window.
 SearchWindow LoopSearchWindow(const GraphSlamOptions& options, double path_m, bool doubtful);
 
-// The window a recovery search covers after `odometry_step_m` of odometry since the last matched
-// scan (`doubtful`: a gap or a zeroed restart around it): recover_window, narrowed where the
-// odometry is not doubtful to ± that length plus recover_slack_m in x and y (never below the local
-// window).
-SearchWindow RecoverySearchWindow(const GraphSlamOptions& options, double odometry_step_m, bool doubtful);
+// The window a recovery search covers after `unmatched_m` of odometry since the last matched scan
+// (`doubtful`: a gap or a zeroed restart around it): recover_window, narrowed where the odometry is
+// not doubtful to ± that length plus recover_slack_m in x and y (never below the local window).
+SearchWindow RecoverySearchWindow(const GraphSlamOptions& options, double unmatched_m, bool doubtful);
 
 // A closure checked in a neighbouring finished submap: the node searched there (loop_verify_window,
 // loop_min_score) around `implied`, the pose the closure puts it at in that submap's grid, is found

@@ -3,6 +3,7 @@
 // scan's start and end, so a particle only has to apply one rigid transform to every ray.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -26,6 +27,13 @@ struct ScanOptions {
   int smooth_beams = 0;
   double smooth_max_step_m = 0.05;
 };
+
+// No return: none measured (not finite, 0 or less), or the sensor's own maximum
+// (`sensor_max_range_m`, 0 when unknown), which a SICK reports through glass or into the open (REP
+// 117's out-of-range).
+inline bool IsNoReturn(double range_m, double sensor_max_range_m) {
+  return !std::isfinite(range_m) || range_m <= 0.0 || (sensor_max_range_m > 0 && range_m >= sensor_max_range_m);
+}
 
 // ranges, angles (counter-clockwise, sensor frame) and fractions (each beam's time within the scan,
 // 0 = start, 1 = end) have one entry per beam. `start_in_end` is the robot's pose at the scan start
