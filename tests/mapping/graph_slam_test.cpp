@@ -498,6 +498,53 @@ TEST(RecoverySearchWindow, ReachesTheOdometrysStepPlusTheSlack) {
   EXPECT_DOUBLE_EQ(RecoverySearchWindow(o, 0.05, false).linear_m, 1.5);
 }
 
+// Across an odometry gap the step says little; the clock bounds the reach instead. A restart, or a
+// reach not known, searches the whole window.
+TEST(RecoverySearchWindow, ReachesAsFarAsTheClockAllowsAcrossAGap) {
+  GraphSlamOptions o;
+  o.local_window = {0.1, 0.2, 0.005};
+  o.recover_window = {1.5, 0.5, 0.005};
+  o.recover_slack_m = 0.3;
+  EXPECT_DOUBLE_EQ(RecoverySearchWindow(o, 0.05, true, 0.4).linear_m, 0.7);
+  EXPECT_DOUBLE_EQ(RecoverySearchWindow(o, 0.6, true, 0.4).linear_m, 0.9);  // the step, if longer
+  EXPECT_DOUBLE_EQ(RecoverySearchWindow(o, 0.05, true, 5.0).linear_m, 1.5);
+  EXPECT_DOUBLE_EQ(RecoverySearchWindow(o, 0.05, true, -1.0).linear_m, 1.5);
+  EXPECT_DOUBLE_EQ(RecoverySearchWindow(o, 0.05, true).linear_m, 1.5);
+}
+
+// The top speed is a high percentile of the speed over 1-2 s spans of matched poses: unknown at
+// first, then the robot's cruise, not a single wrong pose's jump; spans across a recovery or a
+// clock that ran backwards are left out.
+TEST(TopSpeed, IsTheMatchedPosesHighPercentileOverSpansOfASecond) {
+  TopSpeed v;
+  EXPECT_LT(v.Value(), 0);
+  double t = 0, x = 0;
+  auto drive = [&](double speed, double seconds) {
+    for (int k = 0; k < seconds * 10; ++k) {
+      t += 0.1;
+      x += speed * 0.1;
+      v.Add(t, {x, 0, 0}, true);
+    }
+  };
+  drive(0.3, 2.0);
+  EXPECT_LT(v.Value(), 0);  // fewer than 30 spans
+  drive(0.3, 30.0);
+  EXPECT_NEAR(v.Value(), 0.3, 0.011);
+  // A jump of 5 m with a recovery: not a span.
+  x += 5;
+  v.Add(t += 0.1, {x, 0, 0}, false);
+  drive(0.3, 5.0);
+  EXPECT_NEAR(v.Value(), 0.3, 0.011);
+  // The clock runs back 10 s: the spans start again there.
+  t -= 10;
+  drive(0.3, 5.0);
+  EXPECT_NEAR(v.Value(), 0.3, 0.011);
+  // Faster driving raises it once it is more than 1 % of the spans.
+  drive(0.6, 40.0);
+  EXPECT_NEAR(v.Value(), 0.6, 0.011);
+  EXPECT_GT(v.spans(), 300);
+}
+
 // The measure itself: a room's scan faces every way, a corridor's across it only, whatever the
 // scan's heading; the weak axis comes out along the corridor in the map's frame.
 TEST(ScanTranslationConstraint, TellsACorridorFromARoom) {

@@ -99,6 +99,27 @@ TEST(SlamInputs, TrimmingKeepsTheNeighboursOfTheTimeAsked) {
   EXPECT_LE(in.odometry().front().t_us, 9'000'000);
 }
 
+// Graph SLAM's recovery asks whether the odometry since the last scan is doubtful: a gap longer
+// than the limit is reported once, with its length, to the first scan after it began, and not again
+// to the next scan.
+TEST(SlamInputs, AnOdometryGapIsDoubtfulOnceWithItsLength) {
+  SlamSessionOptions o;
+  SlamInputs in(o, 1);
+  for (int k = 0; k <= 10; ++k) in.Add(Odometry(k * 100'000, k * 0.01));   // 0 to 1 s
+  for (int k = 25; k <= 30; ++k) in.Add(Odometry(k * 100'000, k * 0.01));  // a 1.5 s gap, then on
+  const int64_t limit = 1'000'000;
+  EXPECT_FALSE(in.PosesDoubtful(500'000, 900'000, limit).doubtful);
+  const OdometryDoubt across = in.PosesDoubtful(900'000, 2'600'000, limit);
+  EXPECT_TRUE(across.doubtful);
+  EXPECT_NEAR(across.unobserved_s, 1.5, 1e-9);
+  // A scan inside the gap: the gap is still ahead of it, and counts.
+  EXPECT_TRUE(in.PosesDoubtful(900'000, 1'200'000, limit).doubtful);
+  // The scan after: the gap ended at the last scan, which was told.
+  EXPECT_FALSE(in.PosesDoubtful(2'500'000, 2'600'000, limit).doubtful);
+  EXPECT_FALSE(in.PosesDoubtful(2'600'000, 2'700'000, limit).doubtful);
+  EXPECT_FALSE(in.PosesDoubtful(900'000, 2'600'000, 2'000'000).doubtful);  // shorter than a longer limit
+}
+
 TEST(SlamSession, PublishesThePoseEveryScanTheStatusOnChangeAndTheMapEveryKthScan) {
   SlamSessionOptions o;
   o.slam.mode = SlamMode::kFullSlam;

@@ -71,7 +71,9 @@ void GraphSlam::Initialize(const Pose2D& pose, const Pose2D& odometry) {
   initialized_ = true;
 }
 
-Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& odometry, bool odometry_doubtful) {
+Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& odometry, const OdometryDoubt& doubt,
+                              double time_s) {
+  const bool odometry_doubtful = doubt.doubtful;
   if (!initialized_) throw std::logic_error("graph SLAM: ProcessScan before Initialize");
   MaybeApplyFinished();
   const auto t0 = Clock::now();
@@ -80,7 +82,7 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
   // The odometry's motion since the last scan that was matched: a glitch on a scan too sparse to
   // match is still within reach of the next one's recovery search.
   const double unmatched_m = unmatched_m_ + std::hypot(step.x, step.y);
-  bool matched = false;
+  bool matched = false, recovered = false;
   auto points = std::make_shared<const std::vector<Point2>>(ScanHitPoints(rays, options_.point_spacing_m));
   ++stats_.scans;
   if (odometry_doubtful) ++doubtful_seen_;
@@ -113,13 +115,24 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
         }
         // Taken only where it fits as scans usually do, and better than the local answer (by
         // recover_margin of the mean): else that stands. No farther than the odometry since the
-        // last matched scan can have been wrong (the whole window where it is doubtful).
+        // last matched scan can have been wrong; across an odometry gap, no farther than the robot
+        // can have driven by the clock; after a zeroed restart, anywhere in the window.
         const double margin = std::max(options_.recover_margin * mean_score_, 1e-6);
         const double need = std::max(m.found ? m.score + margin : 0.0, options_.recover_below * mean_score_);
-        const MatchResult w = MatchBranchAndBound(*s.wide, *points, local,
-                                                  RecoverySearchWindow(options_, unmatched_m, odometry_doubtful), need);
+        double reach_m = -1.0;
+        const double top = top_speed_.Value(), elapsed_s = time_s - matched_time_s_;
+        if (odometry_doubtful && options_.recover_speed_factor > 0 && top >= 0 && doubt.unobserved_s >= 0 &&
+            elapsed_s >= 0) {
+          reach_m = options_.recover_speed_factor * top * std::max(doubt.unobserved_s, elapsed_s);
+          ++stats_.doubtful_bounded;
+        }
+        const SearchWindow window = RecoverySearchWindow(options_, unmatched_m, odometry_doubtful, reach_m);
+        MatchResult w = MatchBranchAndBound(*s.wide, *points, local, window, need);
+        // The window is a square; the reach is a distance.
+        if (w.found && std::hypot(w.pose.x - local.x, w.pose.y - local.y) > window.linear_m) w.found = false;
         if (w.found) {
           m = w;
+          recovered = true;
           ++stats_.recoveries;
           odometry_doubtful_ = true;
           ++doubtful_seen_;
@@ -148,6 +161,13 @@ Pose2D GraphSlam::ProcessScan(const std::vector<ScanRay>& rays, const Pose2D& od
   last_local_ = local;
   last_odometry_ = odometry;
   unmatched_m_ = matched ? 0.0 : unmatched_m;
+  untrusted_since_match_ = untrusted_since_match_ || odometry_doubtful || recovered;
+  if (matched && std::isfinite(time_s)) {
+    top_speed_.Add(time_s, local, !untrusted_since_match_);
+    stats_.top_speed_m_s = top_speed_.Value();
+    matched_time_s_ = time_s;
+    untrusted_since_match_ = false;
+  }
   bool make_node = nodes_.empty();
   if (!make_node && !sparse) {
     const Pose2D moved = nodes_.back().local.Inverse().Compose(local);
@@ -300,11 +320,42 @@ SearchWindow LoopSearchWindow(const GraphSlamOptions& o, double path_m, bool dou
   return w;
 }
 
-SearchWindow RecoverySearchWindow(const GraphSlamOptions& o, double unmatched_m, bool doubtful) {
+SearchWindow RecoverySearchWindow(const GraphSlamOptions& o, double unmatched_m, bool doubtful,
+                                  double doubtful_reach_m) {
   SearchWindow w = o.recover_window;
-  if (doubtful || o.recover_slack_m <= 0) return w;
-  w.linear_m = std::min(w.linear_m, std::max(o.local_window.linear_m, unmatched_m + o.recover_slack_m));
+  if (o.recover_slack_m <= 0 || (doubtful && !(doubtful_reach_m >= 0))) return w;
+  const double reach = doubtful ? std::max(unmatched_m, doubtful_reach_m) : unmatched_m;
+  w.linear_m = std::min(w.linear_m, std::max(o.local_window.linear_m, reach + o.recover_slack_m));
   return w;
+}
+
+void TopSpeed::Add(double t_s, const Pose2D& pose, bool trusted) {
+  constexpr double kMinSpan = 1.0, kMaxSpan = 2.0;
+  if (!trusted || !std::isfinite(t_s) || (!recent_.empty() && t_s <= recent_.back().first)) recent_.clear();
+  // Keep the newest pose at least kMinSpan old, and those after it.
+  while (recent_.size() >= 2 && t_s - recent_[1].first >= kMinSpan) recent_.pop_front();
+  if (!recent_.empty()) {
+    const double span = t_s - recent_.front().first;
+    if (span >= kMinSpan && span <= kMaxSpan) {
+      const double v = std::hypot(pose.x - recent_.front().second.x, pose.y - recent_.front().second.y) / span;
+      ++histogram_[std::min(kBins - 1, static_cast<int>(v / kBin))];
+      ++spans_;
+    }
+  }
+  if (std::isfinite(t_s)) recent_.emplace_back(t_s, pose);
+}
+
+double TopSpeed::Value() const {
+  constexpr int kMinSpans = 30;
+  if (spans_ < kMinSpans) return -1.0;
+  // The 99th percentile, at its bin's upper edge.
+  const int need = spans_ - spans_ / 100;
+  int seen = 0;
+  for (int b = 0; b < kBins; ++b) {
+    seen += histogram_[b];
+    if (seen >= need) return (b + 1) * kBin;
+  }
+  return kBins * kBin;
 }
 
 SearchWindow GraphSlam::LoopWindow(const Node& n, const Submap& s) const {

@@ -192,6 +192,12 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
                           "prediction than the odometry since the last matched scan plus this (0: the whole "
                           "recovery window)",
                           0.0, 20.0);
+  g.recover_speed_factor =
+      num("recover_speed_factor", g.recover_speed_factor,
+          "front end: where the odometry is doubtful, a recovery searches no farther than this times the robot's "
+          "top speed (from the matched scans) times the time since the last matched scan, plus recover_slack_m "
+          "(0: the whole recovery window)",
+          0.0, 100.0);
   window("recover_window", &g.recover_window, "front end: recovery", 20.0);
   g.front_min_constraint_ratio =
       num("front_min_constraint_ratio", g.front_min_constraint_ratio,

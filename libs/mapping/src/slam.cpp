@@ -85,11 +85,11 @@ void Slam::InitializeGlobal(const motion::Pose2D& odometry) {
 }
 
 SlamStep Slam::ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2D& odometry,
-                           const motion::Pose2D* reference, bool odometry_doubtful) {
+                           const motion::Pose2D* reference, const OdometryDoubt& doubt, double time_s) {
   if (!initialized_) throw std::logic_error("SLAM: ProcessScan before Initialize");
   SlamStep out;
   if (graph_) {
-    out.pose = graph_->ProcessScan(rays, odometry, odometry_doubtful);
+    out.pose = graph_->ProcessScan(rays, odometry, doubt, time_s);
     out.filter_updated = true;
     return out;
   }

@@ -273,18 +273,24 @@ void SlamInputs::AddOdometry(int64_t t_us, const Pose2D& raw, int64_t stamp_us) 
   odometry_.push_back({t_us, out});
 }
 
-bool SlamInputs::PosesDoubtful(int64_t from_us, int64_t to_us, int64_t max_gap_us) const {
+OdometryDoubt SlamInputs::PosesDoubtful(int64_t from_us, int64_t to_us, int64_t max_gap_us) const {
+  OdometryDoubt out;
   for (const int64_t r : restart_times_) {
-    if (r > from_us && r <= to_us) return true;
+    if (r > from_us && r <= to_us) return {true, -1.0};
   }
   const std::vector<TimedPose>& series = poses();
   auto k =
       std::lower_bound(series.begin(), series.end(), from_us, [](const TimedPose& p, int64_t t) { return p.t_us < t; });
   if (k != series.begin()) --k;
+  // The gaps that end after `from_us` (one that ended at the last scan was that scan's).
   for (; k != series.end() && k + 1 != series.end() && k->t_us <= to_us; ++k) {
-    if ((k + 1)->t_us - k->t_us > max_gap_us) return true;
+    const int64_t gap = (k + 1)->t_us - k->t_us;
+    if ((k + 1)->t_us > from_us && gap > max_gap_us) {
+      out.doubtful = true;
+      out.unobserved_s = std::max(out.unobserved_s, gap * 1e-6);
+    }
   }
-  return false;
+  return out;
 }
 
 void SlamInputs::TrimBefore(int64_t t_us) {
@@ -394,10 +400,11 @@ void SlamSession::ProcessScan(const SlamInputs::Scan& p, int64_t t_end, std::vec
   const bool mapping_only = o_.slam.mode == SlamMode::kMappingOnly;
   // Graph SLAM searches widely where the odometry since the last scan crossed a gap or a restart.
   const double gap_s = o_.slam.graph.recover_gap_s;
-  const bool doubtful = o_.slam.mode == SlamMode::kGraphSlam && gap_s > 0 && last_scan_end_us_ >= 0 &&
-                        inputs_.PosesDoubtful(last_scan_end_us_, t_end, static_cast<int64_t>(gap_s * 1e6));
+  const OdometryDoubt doubt = o_.slam.mode == SlamMode::kGraphSlam && gap_s > 0 && last_scan_end_us_ >= 0
+                                  ? inputs_.PosesDoubtful(last_scan_end_us_, t_end, static_cast<int64_t>(gap_s * 1e6))
+                                  : OdometryDoubt{};
   last_scan_end_us_ = t_end;
-  const SlamStep step = slam_.ProcessScan(rays, end_pose, mapping_only ? &end_pose : nullptr, doubtful);
+  const SlamStep step = slam_.ProcessScan(rays, end_pose, mapping_only ? &end_pose : nullptr, doubt, t_end * 1e-6);
   if (step.gated) {
     mbot::log::WarnOnce("slam:gated",
                         "slam: a scan fitting the map at under " + Significant(o_.slam.gate_fit_ratio, 3) +

@@ -9,6 +9,7 @@
 // after each solve (rerender_map) and at the end.
 #pragma once
 
+#include <cmath>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
@@ -27,6 +28,14 @@
 #include "mbot/motion/pose2d.hpp"
 
 namespace mbot::mapping {
+
+// What the odometry says about itself since the last scan (graph SLAM's recovery search).
+struct OdometryDoubt {
+  bool doubtful = false;  // it spans a gap longer than recover_gap_s, or a zeroed restart
+  // How long the robot went unobserved: the longest gap it spans [s]. Negative for a restart,
+  // whose zeroed jump may hide any motion (the whole recover_window is searched then).
+  double unobserved_s = -1.0;
+};
 
 struct GraphSlamOptions {
   // Submaps: their own log-odds grids in the front end's frame.
@@ -63,6 +72,13 @@ struct GraphSlamOptions {
   // the glitched step; with people walking by and glass, wrong ones moved it 1.0-1.7 m on steps of
   // under 0.1 m (0: recover_window always).
   double recover_slack_m = 0.3;
+  // Across an odometry gap its step says little, but the clock does: the robot cannot have gone
+  // farther than this factor times its top speed (TopSpeed: the log's own, from the matched scans)
+  // times the gap (or the time since the last matched scan, if longer), so the search reaches no
+  // farther than that plus recover_slack_m. A zeroed restart, whose jump may have been real motion,
+  // a top speed not yet known or a clock that ran backwards search the whole recover_window (0:
+  // always the whole window on doubtful odometry).
+  double recover_speed_factor = 2.0;
   // A scan that cannot pin its position down along a direction (its surfaces' weakest information
   // below this share of their strongest, ScanTranslationConstraint: a corridor) keeps odometry's
   // motion along it; the fit would put it where the submap's walls end (0: trust the fit).
@@ -110,9 +126,31 @@ struct GraphSlamOptions {
 SearchWindow LoopSearchWindow(const GraphSlamOptions& options, double path_m, bool doubtful);
 
 // The window a recovery search covers after `unmatched_m` of odometry since the last matched scan
-// (`doubtful`: a gap or a zeroed restart around it): recover_window, narrowed where the odometry is
-// not doubtful to ± that length plus recover_slack_m in x and y (never below the local window).
-SearchWindow RecoverySearchWindow(const GraphSlamOptions& options, double unmatched_m, bool doubtful);
+// (`doubtful`: a gap or a zeroed restart around it): recover_window, narrowed to ± that length plus
+// recover_slack_m in x and y (never below the local window); the search also keeps within that
+// distance. Where the odometry is doubtful, the length is the larger of it and `doubtful_reach_m`,
+// the farthest the robot can have gone by the clock (negative: unknown, the whole window).
+SearchWindow RecoverySearchWindow(const GraphSlamOptions& options, double unmatched_m, bool doubtful,
+                                  double doubtful_reach_m = -1.0);
+
+// The robot's top speed as a log shows it: the 99th percentile of its speed over spans of 1-2 s
+// between matched scan poses (a span with a recovery or a doubtful step in it is left out, and a
+// clock that runs backwards starts the spans again). Unknown (negative) before 30 spans.
+class TopSpeed {
+ public:
+  // A matched scan at `t_s` and `pose`; `trusted`: no recovery and no doubtful odometry since the
+  // previous one (else the spans start again here).
+  void Add(double t_s, const motion::Pose2D& pose, bool trusted);
+  double Value() const;
+  int spans() const { return spans_; }
+
+ private:
+  static constexpr double kBin = 0.01;  // m/s
+  static constexpr int kBins = 1000;
+  std::deque<std::pair<double, motion::Pose2D>> recent_;
+  std::vector<int> histogram_ = std::vector<int>(kBins, 0);
+  int spans_ = 0;
+};
 
 // A closure checked in a neighbouring finished submap: the node searched there (loop_verify_window,
 // loop_min_score) around `implied`, the pose the closure puts it at in that submap's grid, is found
@@ -132,6 +170,8 @@ struct GraphSlamStats {
   int scans = 0, nodes = 0, submaps = 0, sparse_scans = 0;
   int recovery_searches = 0, recoveries = 0;  // wide searches made, and those that moved the scan
   int doubtful_searches = 0;                  // of the searches: those the odometry's gap or restart asked for
+  int doubtful_bounded = 0;                   // searches on doubtful odometry the clock narrowed (recover_speed_factor)
+  double top_speed_m_s = -1;                  // TopSpeed at the end (negative: never known)
   int degenerate_scans = 0;                   // whose motion along a corridor came from odometry
   int64_t loop_searches = 0, loop_closures = 0;
   int64_t loop_searches_bounded = 0;  // of the searches: those the path's drift bound kept inside loop_window
@@ -157,10 +197,12 @@ class GraphSlam {
   bool initialized() const { return initialized_; }
   // One scan (rays in the frame of the robot at the scan's end) with the odometry then; returns the
   // scan's pose by the current estimate.
-  // `odometry_doubtful`: the odometry since the last scan spans a gap or a restart (see
-  // GraphSlamOptions::recover_gap_s), so its prior is searched around widely.
+  // `doubt`: whether the odometry since the last scan spans a gap or a restart (see
+  // GraphSlamOptions::recover_gap_s), so its prior is searched around widely. `time_s`: the scan's
+  // time, for the robot's top speed (NaN: unknown; a doubtful step then searches the whole
+  // recover_window).
   motion::Pose2D ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2D& odometry,
-                             bool odometry_doubtful = false);
+                             const OdometryDoubt& doubt = {}, double time_s = std::nan(""));
   // Waits for the worker, closes the last loops, solves the graph to convergence, renders the map.
   void Finish();
 
@@ -260,9 +302,12 @@ class GraphSlam {
   MapperOptions map_options_;
   bool initialized_ = false;
   motion::Pose2D last_odometry_, last_local_;
-  motion::Pose2D correction_;  // global ⊕ local⁻¹, from the last solve
-  double mean_score_ = 0;      // running mean of the front end's match scores
-  double unmatched_m_ = 0;     // odometry path since the last scan the front end matched
+  motion::Pose2D correction_;             // global ⊕ local⁻¹, from the last solve
+  double mean_score_ = 0;                 // running mean of the front end's match scores
+  double unmatched_m_ = 0;                // odometry path since the last scan the front end matched
+  double matched_time_s_ = std::nan("");  // the time of the last scan the front end matched
+  bool untrusted_since_match_ = false;    // a recovery or doubtful odometry since then
+  TopSpeed top_speed_;
   int scores_ = 0;
   bool odometry_doubtful_ = false;  // a recovery since the last node
   int doubtful_seen_ = 0;           // recoveries and doubtful odometry steps so far

@@ -7,6 +7,7 @@
 // Between filter updates (the robot has not moved enough) the pose follows odometry.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -107,9 +108,11 @@ class Slam {
 
   // One scan, its rays in the frame of the robot at the scan's end; `odometry` is the odometry pose
   // at that time; `reference` the externally given pose (mapping-only; ignored otherwise).
-  // `odometry_doubtful` (graph SLAM): the odometry since the last scan crossed a gap or a restart.
+  // `doubt` (graph SLAM): whether the odometry since the last scan crossed a gap or a restart;
+  // `time_s` (graph SLAM): the scan's time, for the robot's top speed.
   SlamStep ProcessScan(const std::vector<ScanRay>& rays, const motion::Pose2D& odometry,
-                       const motion::Pose2D* reference = nullptr, bool odometry_doubtful = false);
+                       const motion::Pose2D* reference = nullptr, const OdometryDoubt& doubt = {},
+                       double time_s = std::nan(""));
 
   // Graph SLAM: closes the last loops and solves the graph (a no-op in the other modes).
   void Finish();

@@ -106,8 +106,9 @@ class SlamInputs {
   int odometry_restarts() const { return continuity_.restarts(); }
   const motion::OdometryContinuity& continuity() const { return continuity_; }
   // Whether the poses between `from_us` and `to_us` (with the readings around them) leave a gap
-  // longer than `max_gap_us`, or the odometry restarted (a zeroed jump) in (from_us, to_us].
-  bool PosesDoubtful(int64_t from_us, int64_t to_us, int64_t max_gap_us) const;
+  // longer than `max_gap_us` that ends after from_us (and the longest such gap), or the odometry
+  // restarted (a zeroed jump) in (from_us, to_us].
+  OdometryDoubt PosesDoubtful(int64_t from_us, int64_t to_us, int64_t max_gap_us) const;
 
   // Drops the pose series' entries before t_us, keeping the last one before it (an interpolation
   // at t_us still has both neighbours), so a run of any length keeps bounded memory. Cheap to call
