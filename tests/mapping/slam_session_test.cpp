@@ -100,8 +100,8 @@ TEST(SlamInputs, TrimmingKeepsTheNeighboursOfTheTimeAsked) {
 }
 
 // Graph SLAM's recovery asks whether the odometry since the last scan is doubtful: a gap longer
-// than the limit is reported once, with its length, to the first scan after it began, and not again
-// to the next scan.
+// than the limit is reported, with its length, to every scan whose step from the last scan it
+// overlaps, and not to a scan whose step starts where the gap ended (the last scan was told).
 TEST(SlamInputs, AnOdometryGapIsDoubtfulOnceWithItsLength) {
   SlamSessionOptions o;
   SlamInputs in(o, 1);
@@ -112,8 +112,10 @@ TEST(SlamInputs, AnOdometryGapIsDoubtfulOnceWithItsLength) {
   const OdometryDoubt across = in.PosesDoubtful(900'000, 2'600'000, limit);
   EXPECT_TRUE(across.doubtful);
   EXPECT_NEAR(across.unobserved_s, 1.5, 1e-9);
-  // A scan inside the gap: the gap is still ahead of it, and counts.
+  // A scan inside the gap: the gap is still ahead of it, and counts; so it does for the next scan,
+  // whose step from inside the gap crosses the rest of it.
   EXPECT_TRUE(in.PosesDoubtful(900'000, 1'200'000, limit).doubtful);
+  EXPECT_TRUE(in.PosesDoubtful(1'200'000, 2'600'000, limit).doubtful);
   // The scan after: the gap ended at the last scan, which was told.
   EXPECT_FALSE(in.PosesDoubtful(2'500'000, 2'600'000, limit).doubtful);
   EXPECT_FALSE(in.PosesDoubtful(2'600'000, 2'700'000, limit).doubtful);

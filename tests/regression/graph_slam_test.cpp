@@ -574,9 +574,9 @@ TEST(GraphSlamRegression, IntelWithGlassAndPeopleStaysWithinBounds) {
 // Seed 2 hides much of one scan at t = 976053147.979, 1.27 s after the one before (the log's clock
 // jumps there; the odometry shows the robot standing). The local fit scores 0.31 against a mean of
 // 0.71, and a look-alike place 1.52 m away fitted better: searching the whole recovery window, the
-// robot jumped there, 0.0235 m with a largest relation error of 1.84 m (2026-12-05). Now the search
-// reaches no farther than twice the top speed (0.37 m/s) times the 1.27 s, plus the slack (1.24 m),
-// and a find beyond that distance is refused (the window is a square): 0.0187 m, largest 0.068 m.
+// robot jumped there, 0.0235 m with a largest relation error of 1.84 m (2026-12-05). The window is a
+// square (±1.5 m); a best find beyond its reach as a distance is now refused: 0.0187 m, largest
+// 0.068 m, with or without the clock's bound on the gap (2 × 0.37 m/s × 1.27 s + 0.3 m = 1.24 m).
 TEST(GraphSlamRegression, IntelWithGlassAndPeopleAcrossAClockGapStaysWithinBounds) {
   ExpectGlassAndPeopleWithinBounds("carmen/intel-raw.clf.gz", "carmen/intel.relations", 15000, "intel_seed2", 50000,
                                    10000, 0.025, 0.5, 0.3, 2);

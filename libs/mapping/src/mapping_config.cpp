@@ -188,15 +188,15 @@ GraphSlamOptions ParseGraphSlamOptions(config::Section& s, const GraphSlamOption
                          "above the local fit (0: any better fit)",
                          0.0, 1.0);
   g.recover_slack_m = num("recover_slack_m", g.recover_slack_m,
-                          "front end: where the odometry is not doubtful, a recovery searches no farther from the "
-                          "prediction than the odometry since the last matched scan plus this (0: the whole "
-                          "recovery window)",
+                          "front end: a recovery searches no farther from the prediction than the odometry since "
+                          "the last matched scan plus this (across an odometry gap, the clock's reach if farther; "
+                          "0: the whole recovery window, with the clock bound off too)",
                           0.0, 20.0);
   g.recover_speed_factor =
       num("recover_speed_factor", g.recover_speed_factor,
-          "front end: where the odometry is doubtful, a recovery searches no farther than this times the robot's "
-          "top speed (from the matched scans) times the time since the last matched scan, plus recover_slack_m "
-          "(0: the whole recovery window)",
+          "front end: across an odometry gap, a recovery searches no farther than this times the robot's top speed "
+          "(from the matched scans) times the gap or the time since the last matched scan, plus recover_slack_m; a "
+          "zeroed restart searches the whole recovery window (0: so does a gap)",
           0.0, 100.0);
   window("recover_window", &g.recover_window, "front end: recovery", 20.0);
   g.front_min_constraint_ratio =

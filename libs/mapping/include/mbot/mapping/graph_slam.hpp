@@ -37,6 +37,10 @@ struct OdometryDoubt {
   double unobserved_s = -1.0;
 };
 
+// Two doubts about the odometry in one (a scan's own and one held from before it): a restart in
+// either leaves any motion possible, else the longer gap counts.
+OdometryDoubt Merge(const OdometryDoubt& a, const OdometryDoubt& b);
+
 struct GraphSlamOptions {
   // Submaps: their own log-odds grids in the front end's frame.
   MapperOptions submap{5, 1, 0.05, 10.0, 10.0, 0.0, 0.0, true, 2.0};
@@ -62,22 +66,26 @@ struct GraphSlamOptions {
   // A recovery moves the scan only where it fits better than in the local window by this share of
   // the running mean score (0: any better fit). 0.15 kept Intel with injected glass and people from a
   // 1.2 m jump (0.566 against 0.499 locally, mean 0.708), but it also refused true recoveries on the
-  // real Intel bag, whose odometry has gaps and restarts (0.0176 m with 0, 0.0201 m with 0.15), and
-  // on the made-harder Intel slice (0.0200 against 0.0289 m). The bound below keeps those jumps out.
+  // real Intel bag, whose odometry has gaps and restarts (0.0176 m with 0, 0.0201 m with 0.15; 0.0177
+  // m with 0 today), and on the made-harder Intel slice (0.0200 against 0.0289 m). The bounds below
+  // keep those jumps out.
   double recover_margin = 0.0;
-  // A glitch is part of the odometry's own step: where the odometry is not doubtful, a recovery
-  // searches no farther from the prediction (± in x and y) than that step plus this slack (the
-  // motion the step may have missed), never beyond recover_window; the steps of scans too sparse to
-  // match count too. The made-harder slices' true recoveries moved the scan at most 0.17 m more than
-  // the glitched step; with people walking by and glass, wrong ones moved it 1.0-1.7 m on steps of
-  // under 0.1 m (0: recover_window always).
+  // A glitch is part of the odometry's own step: a recovery searches no farther from the prediction
+  // than that step plus this slack (the motion the step may have missed), never beyond
+  // recover_window; the steps of scans too sparse to match count too. Across an odometry gap the
+  // clock may allow more (recover_speed_factor). The made-harder slices' true recoveries moved the
+  // scan at most 0.17 m more than the glitched step; with people walking by and glass, wrong ones
+  // moved it 1.0-1.7 m on steps of under 0.1 m. Every recovery, bounded or not, keeps within the
+  // window's reach as a distance, not only as the square the search covers (0: recover_window
+  // always, the clock bound too is off).
   double recover_slack_m = 0.3;
   // Across an odometry gap its step says little, but the clock does: the robot cannot have gone
   // farther than this factor times its top speed (TopSpeed: the log's own, from the matched scans)
   // times the gap (or the time since the last matched scan, if longer), so the search reaches no
-  // farther than that plus recover_slack_m. A zeroed restart, whose jump may have been real motion,
-  // a top speed not yet known or a clock that ran backwards search the whole recover_window (0:
-  // always the whole window on doubtful odometry).
+  // farther than that (or the odometry's step, if longer) plus recover_slack_m. A zeroed restart,
+  // whose jump may have been real motion, a top speed not yet known or a clock that ran backwards
+  // search the whole recover_window. A doubt holds until a scan is matched (0: always the whole
+  // window on doubtful odometry).
   double recover_speed_factor = 2.0;
   // A scan that cannot pin its position down along a direction (its surfaces' weakest information
   // below this share of their strongest, ScanTranslationConstraint: a corridor) keeps odometry's
@@ -135,7 +143,8 @@ SearchWindow RecoverySearchWindow(const GraphSlamOptions& options, double unmatc
 
 // The robot's top speed as a log shows it: the 99th percentile of its speed over spans of 1-2 s
 // between matched scan poses (a span with a recovery or a doubtful step in it is left out, and a
-// clock that runs backwards starts the spans again). Unknown (negative) before 30 spans.
+// clock that runs backwards starts the spans again). Unknown (negative) before 100 spans, below
+// which the percentile would be the maximum.
 class TopSpeed {
  public:
   // A matched scan at `t_s` and `pose`; `trusted`: no recovery and no doubtful odometry since the
@@ -170,7 +179,7 @@ struct GraphSlamStats {
   int scans = 0, nodes = 0, submaps = 0, sparse_scans = 0;
   int recovery_searches = 0, recoveries = 0;  // wide searches made, and those that moved the scan
   int doubtful_searches = 0;                  // of the searches: those the odometry's gap or restart asked for
-  int doubtful_bounded = 0;                   // searches on doubtful odometry the clock narrowed (recover_speed_factor)
+  int doubtful_bounded = 0;                   // searches across an odometry gap the clock narrowed
   double top_speed_m_s = -1;                  // TopSpeed at the end (negative: never known)
   int degenerate_scans = 0;                   // whose motion along a corridor came from odometry
   int64_t loop_searches = 0, loop_closures = 0;
@@ -308,6 +317,7 @@ class GraphSlam {
   double matched_time_s_ = std::nan("");  // the time of the last scan the front end matched
   bool untrusted_since_match_ = false;    // a recovery or doubtful odometry since then
   TopSpeed top_speed_;
+  OdometryDoubt unresolved_doubt_;  // held from doubtful scans since the last matched one
   int scores_ = 0;
   bool odometry_doubtful_ = false;  // a recovery since the last node
   int doubtful_seen_ = 0;           // recoveries and doubtful odometry steps so far
