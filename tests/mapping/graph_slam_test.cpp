@@ -43,6 +43,20 @@ double WorstError(const std::vector<Pose2D>& poses, const std::vector<Pose2D>& t
   return worst;
 }
 
+// The SLAM map that holds the building, with room around it.
+MapperOptions BuildingMap() {
+  MapperOptions map;
+  map.width_m = 14, map.height_m = 10, map.center_x_m = 6, map.center_y_m = 4;
+  return map;
+}
+
+// A drive along the building's long side, one pose every `step_m`.
+std::vector<Pose2D> AlongTheLongSide(double step_m) {
+  std::vector<Pose2D> truth;
+  for (double d = 0; d < 8.4; d += step_m) truth.push_back({1.8 + d, 1.8, 0});
+  return truth;
+}
+
 TEST(MatchGrid, LevelsBoundEveryBlock) {
   const OccupancyGrid world = Building();
   const MatchGrid grid(world, 0.05, 0, 5);
@@ -167,9 +181,7 @@ TEST(GraphSlam, ClosesTheLoopAroundABuildingBlock) {
   o.loop_window = {1.0, 0.3, 0.01};
   o.loop_every_nodes = 2;
   o.loop_max_distance_m = 6.0;
-  MapperOptions map;
-  map.width_m = 14, map.height_m = 10, map.center_x_m = 6, map.center_y_m = 4;
-  GraphSlam slam(o, map);
+  GraphSlam slam(o, BuildingMap());
   Pose2D odometry{0, 0, 0};
   std::mt19937 rng(7);
   std::normal_distribution<double> noise(0.0, 0.005);
@@ -219,14 +231,11 @@ TEST(GraphSlam, CountsScansTooSparseToMatch) {
 // track stays on the truth. Without it the scans after the glitch are placed 0.8 m off.
 double WorstErrorAfterAGlitch(double recover_below, int* recoveries, bool sparse_glitch_scan = false) {
   const OccupancyGrid world = Building();
-  std::vector<Pose2D> truth;
-  for (double d = 0; d < 8.4; d += 0.1) truth.push_back({1.8 + d, 1.8, 0});
+  std::vector<Pose2D> truth = AlongTheLongSide(0.1);
   GraphSlamOptions o;
   o.background = false;
   o.recover_below = recover_below;
-  MapperOptions map;
-  map.width_m = 14, map.height_m = 10, map.center_x_m = 6, map.center_y_m = 4;
-  GraphSlam slam(o, map);
+  GraphSlam slam(o, BuildingMap());
   slam.Initialize(truth[0], {});
   const Pose2D glitch{0.0, 0.8, 0.0};
   for (size_t i = 0; i < truth.size(); ++i) {
@@ -250,18 +259,15 @@ double WorstErrorAfterAGlitch(double recover_below, int* recoveries, bool sparse
 // 1 m/s (scans at 20 Hz), and at one scan its true pose is 0.8 m to the side of what the odometry
 // says, after a gap of `unobserved_s` (a restart when negative). The top speed learnt by then is
 // about 1 m/s, so twice that over the 0.15 s since the last scan (0.3 m) plus the 0.3 m slack
-// cannot reach 0.8 m, over 1.05 s it can; a restart searches the whole window. Returns the front end's error at that
-// scan, as it published it (a loop closure may mend the graph later).
+// cannot reach 0.8 m, over 1.05 s it can; a restart searches the whole window. Returns the front
+// end's error at that scan, as it published it (a loop closure may mend the graph later).
 double FrontEndErrorAfterAGap(double unobserved_s, double speed_factor, int* bounded) {
   const OccupancyGrid world = Building();
-  std::vector<Pose2D> truth;
-  for (double d = 0; d < 8.4; d += 0.05) truth.push_back({1.8 + d, 1.8, 0});
+  const std::vector<Pose2D> truth = AlongTheLongSide(0.05);
   GraphSlamOptions o;
   o.background = false;
   o.recover_speed_factor = speed_factor;
-  MapperOptions map;
-  map.width_m = 14, map.height_m = 10, map.center_x_m = 6, map.center_y_m = 4;
-  GraphSlam slam(o, map);
+  GraphSlam slam(o, BuildingMap());
   slam.Initialize(truth[0], {});
   const size_t gap = truth.size() * 4 / 5;  // after 6.7 s: 114 spans of 1-2 s to learn the speed from
   const Pose2D side{0.0, 0.8, 0.0};

@@ -16,18 +16,18 @@ Json MeanStdJson(const motion::MeanStd& m) { return {{"mean", Number(m.mean)}, {
 }  // namespace
 
 Json GraphSlamJson(const mapping::GraphSlamStats& g) {
-  mbot::log::Info(
-      "slam: graph of " + std::to_string(g.nodes) + " nodes in " + std::to_string(g.submaps) + " submaps; " +
-      std::to_string(g.loop_closures) + " loop closures from " + std::to_string(g.loop_searches) + " searches (" +
-      std::to_string(g.loop_searches_bounded) + " narrowed by the drift bound; " +
-      std::to_string(g.loop_closures_contradicted) + " more dropped as a neighbouring submap placed them elsewhere), " +
-      std::to_string(g.rejected.size()) + " rejected by the robust loss; " + std::to_string(g.sparse_scans) +
-      " scans too sparse to match; " + std::to_string(g.recoveries) + " scans placed by a recovery search (of " +
-      std::to_string(g.recovery_searches) + ", " + std::to_string(g.doubtful_searches) +
-      " for odometry gaps or restarts, " + std::to_string(g.doubtful_bounded) +
-      " of the searches on doubtful odometry bounded by the top speed " +
-      (g.top_speed_m_s >= 0 ? Num(g.top_speed_m_s, 3) + " m/s" : std::string("(unknown)")) + "); " +
-      std::to_string(g.degenerate_scans) + " scans moved by odometry along a corridor");
+  mbot::log::Info("slam: graph of " + std::to_string(g.nodes) + " nodes in " + std::to_string(g.submaps) +
+                  " submaps; " + std::to_string(g.loop_closures) + " loop closures from " +
+                  std::to_string(g.loop_searches) + " searches (" + std::to_string(g.loop_searches_bounded) +
+                  " narrowed by the drift bound; " + std::to_string(g.loop_closures_contradicted) +
+                  " more dropped as a neighbouring submap placed them elsewhere), " +
+                  std::to_string(g.rejected.size()) + " rejected by the robust loss; " +
+                  std::to_string(g.sparse_scans) + " scans too sparse to match; " + std::to_string(g.recoveries) +
+                  " scans placed by a recovery search (of " + std::to_string(g.recovery_searches) + ", " +
+                  std::to_string(g.doubtful_searches) + " for odometry gaps or restarts, " +
+                  std::to_string(g.doubtful_bounded) + " across a gap narrowed by the clock at a top speed of " +
+                  (g.top_speed_m_s >= 0 ? Num(g.top_speed_m_s, 3) + " m/s" : std::string("(unknown)")) + "); " +
+                  std::to_string(g.degenerate_scans) + " scans moved by odometry along a corridor");
   for (size_t i = 0; i < g.rejected.size() && i < 5; ++i) {
     const mapping::RejectedClosure& r = g.rejected[i];
     mbot::log::Warn(
