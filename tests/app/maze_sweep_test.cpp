@@ -20,7 +20,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <map>
 #include <sstream>
 
 #include "../regression/run_config.hpp"
@@ -59,22 +58,6 @@ TEST_P(MazeSample, ExploredMappedAndHomeWithoutCollision) {
 }
 INSTANTIATE_TEST_SUITE_P(GeneratedMazes, MazeSample, ::testing::Values(6, 7, 9, 24, 64));
 
-// A TUM trajectory: stamp -> (x, y).
-std::map<std::string, std::pair<double, double>> ReadTum(const std::string& path) {
-  std::map<std::string, std::pair<double, double>> out;
-  std::ifstream in(path);
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream ss(line);
-    std::string t;
-    double x = 0, y = 0;
-    ss >> t >> x >> y;
-    out[t] = {x, y};
-  }
-  return out;
-}
-
 // config/maze_replay.ini runs the Maze Explorer's estimator (config/maze_slam.ini) on a recorded
 // run (maze_1, recorded by an lcm_log output): its poses are the closed-loop run's, scan by scan, so
 // an estimator change can be measured on the inputs that showed a problem.
@@ -86,8 +69,8 @@ TEST(MazeReplay, TheExplorersSlamOnItsOwnRecordingFollowsTheRun) {
   const std::string metrics =
       RunConfig("maze_replay.ini", "maze_replay_out", {"source.path=" + run + "/run.log"}, "metrics.json");
   ASSERT_FALSE(metrics.empty()) << "the replay wrote no metrics.json";
-  const auto live = ReadTum(run + "/slam.tum");
-  const auto replay = ReadTum(::testing::TempDir() + "/maze_replay_out/slam.tum");
+  const auto live = TumXy(run + "/slam.tum");
+  const auto replay = TumXy(::testing::TempDir() + "/maze_replay_out/slam.tum");
   ASSERT_GT(live.size(), 300u);
   size_t paired = 0;
   double sum2 = 0, largest = 0;

@@ -96,20 +96,6 @@ TEST(GraphSlamRegression, WritesTheGraphAsG2oAndTheMapAtAnyResolution) {
 // second run starts 5,000 events into the log with no pose (initial_pose = global), finds its first
 // scan on that map by a whole-map search and tracks on. Both runs' poses agree at the same stamps.
 // A map of another place is an error naming the map.
-std::map<std::string, std::pair<double, double>> TumXy(const std::string& path) {
-  std::map<std::string, std::pair<double, double>> out;
-  std::ifstream in(path);
-  std::string line;
-  while (std::getline(in, line)) {
-    if (line.empty() || line[0] == '#') continue;
-    std::istringstream s(line);
-    std::string t;
-    double x, y;
-    if (s >> t >> x >> y) out[t] = {x, y};
-  }
-  return out;
-}
-
 TEST(GraphSlamRegression, AResumedSessionFindsItselfOnAFinishedMap) {
   ASSERT_FALSE(RunConfig("graph_slam.ini", "graph_slam_map_first",
                          {"pipeline.max_events=8000", "slam.graph_background=false"}, "metrics.json")

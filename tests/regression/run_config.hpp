@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -53,6 +54,21 @@ inline double Get(const std::string& json, const std::vector<std::string>& keys)
   }
   pos = json.find(':', pos);
   return std::stod(json.substr(pos + 1));
+}
+
+// A TUM trajectory's positions by stamp (the stamp as written, so two runs' files pair exactly).
+inline std::map<std::string, std::pair<double, double>> TumXy(const std::string& path) {
+  std::map<std::string, std::pair<double, double>> out;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream s(line);
+    std::string t;
+    double x, y;
+    if (s >> t >> x >> y) out[t] = {x, y};
+  }
+  return out;
 }
 
 // The Maze Explorer's bounds on a referee's score.json: completed, no collision, >= 99 % of the
