@@ -76,6 +76,39 @@ TEST(Ndt, PlacesANoisyScanBetweenCellsAndTheMomentsFollowAGrowingGrid) {
   EXPECT_EQ(none.pose.x, start.x);
 }
 
+// MapperOptions::hit_range_power: a hit weighs (its range / 1 m)^power in its cell's moments, so a
+// wall seen from afar is not outweighed by the hits the robot takes of it scan after scan from
+// close by (the map then follows the robot's last poses; BENCHMARKS.md, maze 27).
+TEST(Ndt, HitsWeighTheirRangeToThePowerInTheMoments) {
+  auto cell_after = [](double power) {
+    MapperOptions mo;
+    mo.hit_moments = true;
+    mo.hit_range_power = power;
+    mo.width_m = mo.height_m = 6.0;
+    LogOddsMapper mapper(mo);
+    // Two hits in the cell around (1.0, 0.0): from 2 m away, 1 cm east of the cell's centre, and
+    // from 0.5 m away, 1 cm west of it; then one from 0.05 m (counted as 0.1 m).
+    int cx, cy;
+    mapper.map().WorldToCell(1.0, 0.0, &cx, &cy);
+    double mx, my;
+    mapper.map().CellToWorld(cx, cy, &mx, &my);
+    EXPECT_TRUE(mapper.Insert({ScanRay{0, 0, 2.0f, 0, true}}, Pose2D{mx + 0.01 - 2.0, my, 0}));
+    EXPECT_TRUE(mapper.Insert({ScanRay{0, 0, 0.5f, 0, true}}, Pose2D{mx - 0.01 - 0.5, my, 0}));
+    EXPECT_TRUE(mapper.Insert({ScanRay{0, 0, 0.05f, 0, true}}, Pose2D{mx - 0.05, my, 0}));
+    return mapper.moments().at(cx, cy, HitMoments::DirectionOf(0.0));
+  };
+  const CellMoments alike = cell_after(0.0);
+  EXPECT_FLOAT_EQ(alike.n, 3.0f);
+  EXPECT_NEAR(alike.sx / alike.n, 0.0, 1e-6);  // +1 cm, −1 cm and the centre
+  const CellMoments squared = cell_after(2.0);
+  EXPECT_FLOAT_EQ(squared.n, 4.0f + 0.25f + 0.01f);
+  EXPECT_NEAR(squared.sx / squared.n, (4.0 * 0.01 - 0.25 * 0.01) / 4.26, 1e-6);  // the far view leads
+  const CellMoments linear = cell_after(1.0);
+  EXPECT_FLOAT_EQ(linear.n, 2.0f + 0.5f + 0.1f);
+  // Full SLAM sets the mapper's power from the refine's option; 2 unless a config says otherwise.
+  EXPECT_EQ(NdtOptions{}.range_power, 2.0);
+}
+
 // Full SLAM from an empty map with the MBot's range noise and odometry whose heading drifts 0.3°
 // per 5 cm: with the estimate fitted to the hits the heading stays within a few tenths of a degree.
 TEST(Ndt, FullSlamWithTheRefinedEstimateHoldsTheHeadingUnderRangeNoise) {

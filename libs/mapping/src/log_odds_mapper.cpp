@@ -119,6 +119,13 @@ void BresenhamLine(int x0, int y0, int x1, int y1, std::vector<int>* xs, std::ve
   }
 }
 
+double LogOddsMapper::HitWeight(double range_m) const {
+  const double p = options_.hit_range_power;
+  if (p == 0) return 1.0;
+  const double r = std::max(0.1, range_m);
+  return p == 2 ? r * r : std::pow(r, p);
+}
+
 bool LogOddsMapper::Insert(const std::vector<ScanRay>& rays, const motion::Pose2D& robot_pose) {
   if (rays.empty()) return true;
   if (!std::isfinite(robot_pose.x) || !std::isfinite(robot_pose.y) || !std::isfinite(robot_pose.theta)) {
@@ -184,7 +191,8 @@ bool LogOddsMapper::Insert(const std::vector<ScanRay>& rays, const motion::Pose2
       const int v = end_hit ? std::min(127, cell + hit) : std::max(-127, cell - miss);
       cell = static_cast<int8_t>(v);
       if (end_hit && options_.hit_moments) {
-        moments_.Add(map_, xs[k], ys[k], w.ex, w.ey, HitMoments::DirectionOf(std::atan2(w.ey - w.oy, w.ex - w.ox)));
+        moments_.Add(map_, xs[k], ys[k], w.ex, w.ey, HitMoments::DirectionOf(std::atan2(w.ey - w.oy, w.ex - w.ox)),
+                     HitWeight(std::hypot(w.ex - w.ox, w.ey - w.oy)));
       }
     }
   }

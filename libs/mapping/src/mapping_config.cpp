@@ -300,6 +300,10 @@ SlamOptions ParseSlamOptions(config::Section& s) {
                                            "refine_estimate: pull towards the filter's heading [1/rad]", 0.0, 1e9);
     m.refine.min_sigma_m = s.GetDouble("refine_min_sigma_m", m.refine.min_sigma_m,
                                        "refine_estimate: added to each cell block's spread of hits", 1e-4, 1.0);
+    m.refine.range_power = s.GetDouble("refine_range_power", m.refine.range_power,
+                                       "refine_estimate: each hit weighs (its range / 1 m)^this in the blocks "
+                                       "(0: alike; near hits taken scan after scan make the map follow the last poses)",
+                                       0.0, 4.0);
   }
   // The graph keys exist in graph_slam mode only (elsewhere they are unknown keys); --list-stages
   // documents them too.

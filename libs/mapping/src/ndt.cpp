@@ -30,15 +30,16 @@ void HitMoments::Grow(const OccupancyGrid& grid, int left, int bottom) {
   cells_ = std::move(grown);
 }
 
-void HitMoments::Add(const OccupancyGrid& grid, int cx, int cy, double x, double y, int direction) {
+void HitMoments::Add(const OccupancyGrid& grid, int cx, int cy, double x, double y, int direction, double weight) {
   if (grid.width() != width_ || grid.height() != height_) throw std::logic_error("hit moments: not the grid's size");
   double mx, my;
   grid.CellToWorld(cx, cy, &mx, &my);
   const float dx = static_cast<float>(x - mx), dy = static_cast<float>(y - my);
   CellMoments& m = cells_[(static_cast<size_t>(cy) * width_ + cx) * kDirections + direction];
-  m.n += 1;
-  m.sx += dx, m.sy += dy;
-  m.sxx += dx * dx, m.sxy += dx * dy, m.syy += dy * dy;
+  const float w = static_cast<float>(weight);
+  m.n += w;
+  m.sx += w * dx, m.sy += w * dy;
+  m.sxx += w * dx * dx, m.sxy += w * dx * dy, m.syy += w * dy * dy;
 }
 
 namespace {

@@ -43,7 +43,10 @@ SlamOptions Refined(SlamOptions o) {
 
 MapperOptions WithMoments(const SlamOptions& o) {
   MapperOptions m = o.mapper;
-  m.hit_moments = m.hit_moments || (o.refine_estimate && o.mode == SlamMode::kFullSlam);
+  if (o.refine_estimate && o.mode == SlamMode::kFullSlam) {
+    m.hit_moments = true;
+    m.hit_range_power = o.refine.range_power;
+  }
   return m;
 }
 }  // namespace

@@ -24,6 +24,11 @@ struct MapperOptions {
   bool grow = true;           // false: rays leaving the extent are clipped (never past kMaxGridCells)
   double grow_block_m = 5.0;  // the extent grows by multiples of this
   bool hit_moments = false;   // keep each cell's hit moments (ndt.hpp) beside the grid
+  // Each hit adds to its cell's moments with the weight (its range / 1 m)^hit_range_power (ranges
+  // under 0.1 m count as 0.1 m); 0: every hit alike. The robot's own hits from close by, taken
+  // scan after scan, otherwise outweigh what it saw of the same wall from afar: the moments then
+  // follow its last few poses, and a fit against them inherits each pose's error (ndt.hpp).
+  double hit_range_power = 0.0;
 };
 
 class LogOddsMapper {
@@ -47,6 +52,7 @@ class LogOddsMapper {
  private:
   bool EnsureCovers(double min_x, double min_y, double max_x, double max_y);
   void ResetMoments();  // options_.hit_moments: zero moments for map_ (refused past HitMoments::kMaxCells)
+  double HitWeight(double range_m) const;  // a hit's weight in the moments (hit_range_power)
 
   MapperOptions options_;
   OccupancyGrid map_;

@@ -18,7 +18,8 @@
 
 namespace mbot::mapping {
 
-// Per cell: the count, sums and sums of squares of the hits' offsets from the cell's centre.
+// Per cell: the count, sums and sums of squares of the hits' offsets from the cell's centre (each
+// hit counted with its weight).
 struct CellMoments {
   float n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
 };
@@ -41,8 +42,9 @@ class HitMoments {
   // After `grid` grew by `left` and `bottom` cells on those sides (and others on the far sides): the
   // moments move with their cells.
   void Grow(const OccupancyGrid& grid, int left, int bottom);
-  // A hit at (x, y) in cell (cx, cy) of `grid`, by a ray in direction `direction` (DirectionOf).
-  void Add(const OccupancyGrid& grid, int cx, int cy, double x, double y, int direction);
+  // A hit at (x, y) in cell (cx, cy) of `grid`, by a ray in direction `direction` (DirectionOf),
+  // counted `weight` times (MapperOptions::hit_range_power).
+  void Add(const OccupancyGrid& grid, int cx, int cy, double x, double y, int direction, double weight = 1.0);
   const CellMoments& at(int cx, int cy, int direction) const {
     return cells_[(static_cast<size_t>(cy) * width_ + cx) * kDirections + direction];
   }
@@ -56,7 +58,7 @@ class HitMoments {
 
 struct NdtOptions {
   int occupied_threshold = 0;   // a block with a cell above this log-odds lends its hits
-  int min_hits = 10;            // a block with fewer hits scores nothing
+  int min_hits = 10;            // a block with fewer hits (their summed weight) scores nothing
   double min_sigma_m = 0.01;    // added to every Gaussian's spread (a wall seen once is not a line)
   double outlier_sigmas = 3.0;  // points farther than this (Mahalanobis) from their block's mean weigh less
   // Pulls towards the initial pose: 1 / the prior's standard deviation (0: none), 5 cm and 6° by
@@ -64,6 +66,12 @@ struct NdtOptions {
   double translation_weight = 20.0;  // [1/m]
   double rotation_weight = 10.0;     // [1/rad]
   int max_iterations = 10;
+  // The weight of a hit in the moments the fit uses: (its range / 1 m)^range_power (the mapper's
+  // MapperOptions::hit_range_power, set from here by full SLAM). Weighed alike (0), the hits the robot
+  // just took from close by make most of every block, so each fit is mostly against its own last few
+  // poses and a bias of a fraction of a millimetre a fit compounds: on the generated mazes with the
+  // MBot's measured 2.2 cm of range noise the map came out about 1 % small (BENCHMARKS.md, maze 27).
+  double range_power = 2.0;
 };
 
 struct NdtResult {
