@@ -67,8 +67,9 @@ INSTANTIATE_TEST_SUITE_P(GeneratedMazes, MazeSample, ::testing::Values(6, 7, 9, 
 // Maze 27 with the lidar's measured range noise (2.2 cm, BENCHMARKS.md "The simulator fitted"): the
 // map came out 1 % small, its far walls a cell inward (walls 0.938, coverage 0.982 on seed 1), while
 // the refine's hit moments weighed every hit alike. With each hit weighing its range squared
-// (`refine_range_power = 2`): walls 0.997, coverage 0.999. The estimate's scale against the truth
-// (least squares, as scripts/path_scale.py) is recorded: 0.9917 against 0.9898 before.
+// (`refine_range_power = 2`): walls 0.98, coverage 0.995; the bounds are what tell the two apart.
+// The estimate's scale against the truth (least squares, as scripts/path_scale.py) is recorded,
+// 0.9915 against 0.9898 before, and only bounded loosely: a closed loop moves with any change.
 TEST(MazeAtTheMeasuredNoise, Maze27IsMappedToScale) {
   const MazeRun r = ExploreGeneratedMaze(27, {"source.lidar_range_noise_m=0.022", "pipeline.seed=1"});
   ExpectExploredMappedAndHome(r.json);

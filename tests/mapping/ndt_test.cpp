@@ -80,32 +80,39 @@ TEST(Ndt, PlacesANoisyScanBetweenCellsAndTheMomentsFollowAGrowingGrid) {
 // wall seen from afar is not outweighed by the hits the robot takes of it scan after scan from
 // close by (the map then follows the robot's last poses; BENCHMARKS.md, maze 27).
 TEST(Ndt, HitsWeighTheirRangeToThePowerInTheMoments) {
+  constexpr double kHeading = 0.3;  // well inside a direction sector
   auto cell_after = [](double power) {
     MapperOptions mo;
     mo.hit_moments = true;
     mo.hit_range_power = power;
     mo.width_m = mo.height_m = 6.0;
     LogOddsMapper mapper(mo);
-    // Two hits in the cell around (1.0, 0.0): from 2 m away, 1 cm east of the cell's centre, and
-    // from 0.5 m away, 1 cm west of it; then one from 0.05 m (counted as 0.1 m).
+    // Three hits along one heading in the cell around (1.02, 0.52), away from its borders: from 2 m,
+    // 1 cm past the cell's centre; from 0.5 m, 1 cm short of it; from 0.05 m (counted as 0.1 m), at it.
     int cx, cy;
-    mapper.map().WorldToCell(1.0, 0.0, &cx, &cy);
+    mapper.map().WorldToCell(1.02, 0.52, &cx, &cy);
     double mx, my;
     mapper.map().CellToWorld(cx, cy, &mx, &my);
-    EXPECT_TRUE(mapper.Insert({ScanRay{0, 0, 2.0f, 0, true}}, Pose2D{mx + 0.01 - 2.0, my, 0}));
-    EXPECT_TRUE(mapper.Insert({ScanRay{0, 0, 0.5f, 0, true}}, Pose2D{mx - 0.01 - 0.5, my, 0}));
-    EXPECT_TRUE(mapper.Insert({ScanRay{0, 0, 0.05f, 0, true}}, Pose2D{mx - 0.05, my, 0}));
-    return mapper.moments().at(cx, cy, HitMoments::DirectionOf(0.0));
+    const double ux = std::cos(kHeading), uy = std::sin(kHeading);
+    for (const auto& [range, past] : {std::pair{2.0, 0.01}, std::pair{0.5, -0.01}, std::pair{0.05, 0.0}}) {
+      const Pose2D from{mx + (past - range) * ux, my + (past - range) * uy, kHeading};
+      EXPECT_TRUE(mapper.Insert({ScanRay{0, 0, float(range), 0, true}}, from));
+    }
+    return mapper.moments().at(cx, cy, HitMoments::DirectionOf(kHeading));
   };
+  const double ux = std::cos(kHeading);
   const CellMoments alike = cell_after(0.0);
   EXPECT_FLOAT_EQ(alike.n, 3.0f);
-  EXPECT_NEAR(alike.sx / alike.n, 0.0, 1e-6);  // +1 cm, −1 cm and the centre
+  EXPECT_FLOAT_EQ(alike.hits, 3.0f);
+  EXPECT_NEAR(alike.sx / alike.n, 0.0, 1e-6);  // +1 cm, -1 cm and the centre
   const CellMoments squared = cell_after(2.0);
   EXPECT_FLOAT_EQ(squared.n, 4.0f + 0.25f + 0.01f);
-  EXPECT_NEAR(squared.sx / squared.n, (4.0 * 0.01 - 0.25 * 0.01) / 4.26, 1e-6);  // the far view leads
+  EXPECT_FLOAT_EQ(squared.hits, 3.0f);                                         // what min_hits counts
+  EXPECT_NEAR(squared.sx / squared.n, (4.0 - 0.25) * 0.01 * ux / 4.26, 1e-6);  // the far view leads
   const CellMoments linear = cell_after(1.0);
   EXPECT_FLOAT_EQ(linear.n, 2.0f + 0.5f + 0.1f);
-  // Full SLAM sets the mapper's power from the refine's option; 2 unless a config says otherwise.
+  // Full SLAM passes the refine's option to its mapper (slam.cpp); 2 unless a config says otherwise.
+  // MazeAtTheMeasuredNoise fails with it at 0.
   EXPECT_EQ(NdtOptions{}.range_power, 2.0);
 }
 

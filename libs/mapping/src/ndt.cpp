@@ -38,6 +38,7 @@ void HitMoments::Add(const OccupancyGrid& grid, int cx, int cy, double x, double
   CellMoments& m = cells_[(static_cast<size_t>(cy) * width_ + cx) * kDirections + direction];
   const float w = static_cast<float>(weight);
   m.n += w;
+  m.hits += 1;
   m.sx += w * dx, m.sy += w * dy;
   m.sxx += w * dx * dx, m.sxy += w * dx * dy, m.syy += w * dy * dy;
 }
@@ -69,10 +70,10 @@ bool BlockAt(const OccupancyGrid& grid, const HitMoments& moments, int cx, int c
   const int sectors[3] = {(direction + HitMoments::kDirections - 1) % HitMoments::kDirections, direction,
                           (direction + 1) % HitMoments::kDirections};
   auto hits_at = [&](int x, int y) {
-    return moments.at(x, y, sectors[0]).n + moments.at(x, y, sectors[1]).n + moments.at(x, y, sectors[2]).n;
+    return moments.at(x, y, sectors[0]).hits + moments.at(x, y, sectors[1]).hits + moments.at(x, y, sectors[2]).hits;
   };
   if (!wall || hits_at(cx, cy) <= 0) return false;
-  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, hits = 0;
   for (int y = y0; y <= y1; ++y) {
     for (int x = x0; x <= x1; ++x) {
       for (const int k : sectors) {
@@ -81,6 +82,7 @@ bool BlockAt(const OccupancyGrid& grid, const HitMoments& moments, int cx, int c
         // Offsets from the block's centre cell: each cell's lie (x − cx, y − cy) cells off it.
         const double ox = (x - cx) * res, oy = (y - cy) * res;
         n += m.n;
+        hits += m.hits;
         sx += m.sx + m.n * ox;
         sy += m.sy + m.n * oy;
         sxx += m.sxx + 2 * ox * m.sx + m.n * ox * ox;
@@ -89,7 +91,7 @@ bool BlockAt(const OccupancyGrid& grid, const HitMoments& moments, int cx, int c
       }
     }
   }
-  if (n < o.min_hits) return false;
+  if (hits < o.min_hits) return false;
   const double mx = sx / n, my = sy / n;
   const double s0 = o.min_sigma_m * o.min_sigma_m;
   Eigen::Matrix2d cov;
