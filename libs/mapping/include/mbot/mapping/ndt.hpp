@@ -67,12 +67,8 @@ struct NdtOptions {
   double translation_weight = 20.0;  // [1/m]
   double rotation_weight = 10.0;     // [1/rad]
   int max_iterations = 10;
-  // The weight of a hit in the moments the fit uses: (its range / 1 m)^range_power (the mapper's
-  // MapperOptions::hit_range_power, set from here by full SLAM). Weighed alike (0), the hits the robot
-  // just took from close by make most of every block, so each fit is mostly against its own last few
-  // poses and a bias of a fraction of a millimetre a fit compounds: on the generated mazes with the
-  // MBot's measured 2.2 cm of range noise the maps came out 0.47 % small on average, maze 27 1 %
-  // (BENCHMARKS.md, "Maze 27").
+  // Each hit weighs (its range / 1 m)^range_power in the moments the fit uses: full SLAM passes it
+  // to its mapper as MapperOptions::hit_range_power (why: there; figures: BENCHMARKS.md, "Maze 27").
   double range_power = 2.0;
 };
 
