@@ -32,6 +32,9 @@ TEST(Reports, AScoreIsWrittenWholeAndReadsBack) {
   s.crates.push_back({1, 11, true, true, false, {0.5, 0.25, 0.1}, 0.12});
   s.items = {{"lift crate 1", "lifted", 50, 50}, {"stack crate 1 on 11", "on 11", 50, 50}};
   s.total = 100, s.max_total = 100;
+  s.collisions = 2;
+  s.collision_events = {{12.5, {1.0, 2.0, 0.5}, motion::Pose2D{1.03, 2.04, 0.5}, 0.1},
+                        {20.0, {0.5, 0.5, 0.0}, std::nullopt, 0.0}};
   const std::string path = ::testing::TempDir() + "/score_report.json";
   WriteJson(path, ScoreReport(s, {"worlds/heavy_lift.arena", "heavy_lift", 3, false, 10.0}));
   const Json j = ReadJson(path);
@@ -45,9 +48,18 @@ TEST(Reports, AScoreIsWrittenWholeAndReadsBack) {
   EXPECT_TRUE(j["crates"][0]["stacked"].get<bool>());
   EXPECT_EQ(j["points"]["lift crate 1"], 50);
   EXPECT_EQ(j["points"]["total"], 100);
-  EXPECT_FALSE(j.contains("stops"));    // the Warehouse's only
-  EXPECT_EQ(j.begin().key(), "event");  // the report's order, not the alphabet's
-  EXPECT_NE(RubricText(s, {"", "heavy_lift", 3, false, 10.0}).find("completed after 146.1 s"), std::string::npos);
+  ASSERT_EQ(j["collision_events"].size(), 2u);
+  EXPECT_DOUBLE_EQ(j["collision_events"][0]["t_s"].get<double>(), 12.5);
+  EXPECT_DOUBLE_EQ(j["collision_events"][0]["pose"]["y"].get<double>(), 2.0);
+  EXPECT_DOUBLE_EQ(j["collision_events"][0]["estimate_error_m"].get<double>(), 0.05);
+  EXPECT_FALSE(j["collision_events"][1].contains("estimate"));  // SLAM had published nothing yet
+  EXPECT_FALSE(j.contains("stops"));                            // the Warehouse's only
+  EXPECT_EQ(j.begin().key(), "event");                          // the report's order, not the alphabet's
+  const std::string text = RubricText(s, {"", "heavy_lift", 3, false, 10.0});
+  EXPECT_NE(text.find("completed after 146.1 s"), std::string::npos);
+  EXPECT_NE(text.find("collision at 12.5 s, true pose (1, 2) m, SLAM's estimate 0.1 s before it 0.05 m off"),
+            std::string::npos)
+      << text;
 }
 
 TEST(Reports, AnUnreadableReportIsNamed) {

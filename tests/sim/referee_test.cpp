@@ -124,5 +124,32 @@ TEST(RefereeSpeedRun, ScoresAPerfectLapAndEndsAfterTheMission) {
   EXPECT_TRUE(late.Judge().timed_out);
 }
 
+// Each collision is kept with its time since the start, the true pose and SLAM's last estimate
+// before it, taken from the map frame (the start) into the world.
+TEST(RefereeCollisions, EachIsKeptWithItsTimePoseAndTheEstimateThen) {
+  const World world = World::Load(std::string(MBOT_SOURCE_DIR) + "/datasets/arenas/convex_circuit.arena");
+  Referee r({CompetitionEvent::kMazeExplorer, 120.0, 0.5}, world, 1);
+  const Pose2D start{1.0, 0.5, M_PI / 2};
+  r.Tick(1'000'000);
+  r.OnTruePose(1'000'000, start);
+  r.Tick(2'000'000);
+  r.OnCollision(2'000'000, {1.0, 0.4, M_PI});  // before SLAM published: no estimate
+  r.OnSlamPose(2'500'000, {0.3, 0.0, 0.0});    // 0.3 m ahead of the start, in the start's frame
+  r.Tick(3'000'000);
+  r.OnTruePose(3'000'000, {1.0, 0.82, M_PI / 2});
+  r.OnCollision(3'000'000, {1.0, 0.82, M_PI / 2});
+  const Score s = r.Judge();
+  EXPECT_EQ(s.collisions, 2);
+  ASSERT_EQ(s.collision_events.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.collision_events[0].t_s, 1.0);
+  EXPECT_DOUBLE_EQ(s.collision_events[0].pose.theta, M_PI);
+  EXPECT_FALSE(s.collision_events[0].estimate);
+  EXPECT_DOUBLE_EQ(s.collision_events[1].t_s, 2.0);
+  ASSERT_TRUE(s.collision_events[1].estimate);
+  EXPECT_NEAR(s.collision_events[1].estimate->x, 1.0, 1e-12);  // ahead of the start is +y in the world
+  EXPECT_NEAR(s.collision_events[1].estimate->y, 0.8, 1e-12);
+  EXPECT_DOUBLE_EQ(s.collision_events[1].estimate_age_s, 0.5);
+}
+
 }  // namespace
 }  // namespace mbot::sim

@@ -5,6 +5,7 @@
 // (.map + PNG with the planned, driven and true paths, warehouse stops), the printed rubric and the
 // competition's table row.
 #include <chrono>
+#include <cmath>
 #include <iostream>
 
 #include "mbot/common/atomic_file.hpp"
@@ -22,6 +23,8 @@ namespace {
 
 using motion::Pose2D;
 using msgs::EventKind;
+
+constexpr int kPngScale = 4;  // final_map.png: pixels per map cell
 
 struct RefereeStageOptions {
   sim::RefereeOptions referee;
@@ -50,7 +53,7 @@ class RefereeStage : public Stage {
     referee_->Tick(ev.t_us);
     switch (ev.kind) {
       case EventKind::kGroundTruth: referee_->OnTruePose(ev.t_us, std::get<Pose2D>(ev.payload)); break;
-      case EventKind::kCollision: referee_->OnCollision(); break;
+      case EventKind::kCollision: referee_->OnCollision(ev.t_us, std::get<Pose2D>(ev.payload)); break;
       case EventKind::kCrates: referee_->OnCrates(std::get<msgs::CrateStates>(ev.payload)); break;
       case EventKind::kPoseEstimate: referee_->OnSlamPose(ev.t_us, std::get<Pose2D>(ev.payload)); break;
       case EventKind::kMap: referee_->OnMap(std::get<std::shared_ptr<const mapping::OccupancyGrid>>(ev.payload)); break;
@@ -98,7 +101,12 @@ class RefereeStage : public Stage {
       if (!crates.empty()) overlays.push_back({crates, 148, 103, 189, true, "crates at the end"});
       if (s.map && !s.map->unmapped.empty())
         overlays.push_back({s.map->unmapped, 240, 140, 0, true, "reachable space not mapped"});
-      drivers::WriteMapPngWithOverlays(mapping::CropToKnown(*map, 0.3), overlays, 4, dir + "/final_map.png");
+      std::vector<Pose2D> hits;
+      for (const sim::CollisionRecord& r : s.collision_events) hits.push_back(inv.Compose(r.pose));
+      // A ring the size of the robot's body where it touched.
+      const int ring = static_cast<int>(std::lround(o_.referee.robot_radius_m / map->resolution() * kPngScale));
+      if (!hits.empty()) overlays.push_back({hits, 230, 0, 180, true, "collisions", ring});
+      drivers::WriteMapPngWithOverlays(mapping::CropToKnown(*map, 0.3), overlays, kPngScale, dir + "/final_map.png");
     }
     reports::WriteJson(dir + "/score.json", reports::ScoreReport(s, c));
     if (ctx.event_result) {

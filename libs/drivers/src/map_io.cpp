@@ -381,7 +381,8 @@ void WriteMapPngWithOverlays(const msgs::OccupancyGrid& g, const std::vector<Map
   for (const MapOverlay& o : overlays) {
     const cv::Scalar colour(o.b, o.g, o.r);
     if (o.points) {
-      for (const msgs::Pose2D& p : o.poses) cv::circle(img, pixel(p), 1, colour, cv::FILLED);
+      const int r = std::max(1, o.point_radius_px);
+      for (const msgs::Pose2D& p : o.poses) cv::circle(img, pixel(p), r, colour, r > 2 ? 2 : cv::FILLED, cv::LINE_AA);
     } else if (o.poses.size() > 1) {
       std::vector<cv::Point> line;
       line.reserve(o.poses.size());

@@ -1,5 +1,6 @@
 #include "mbot/reports/score.hpp"
 
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -36,6 +37,17 @@ Json ScoreReport(const sim::Score& s, const ScoreContext& c) {
   j["wall_seconds"] = Number(c.wall_s);
   j["real_time_factor"] = Number(rtf);
   j["collisions"] = s.collisions;
+  Json hits = Json::array();
+  for (const sim::CollisionRecord& r : s.collision_events) {
+    Json h = {{"t_s", Number(r.t_s)}, {"pose", PoseJson(r.pose)}};
+    if (r.estimate) {
+      h["estimate"] = PoseJson(*r.estimate);
+      h["estimate_error_m"] = Number(std::hypot(r.estimate->x - r.pose.x, r.estimate->y - r.pose.y));
+      h["estimate_age_s"] = Number(r.estimate_age_s);
+    }
+    hits.push_back(std::move(h));
+  }
+  j["collision_events"] = std::move(hits);
   j["start"] = PoseJson(s.start);
   j["final"] = PoseJson(s.final_pose);
   if (s.final_error) j["final_error"] = ErrorJson(*s.final_error);
@@ -92,6 +104,14 @@ std::string RubricText(const sim::Score& s, const ScoreContext& c) {
   }
   t << "  " << std::left << std::setw(88) << "total" << std::right << std::setw(4) << s.total << " / " << s.max_total
     << "\n";
+  for (const sim::CollisionRecord& r : s.collision_events) {
+    t << "  collision at " << Significant(r.t_s, 4) << " s, true pose (" << Significant(r.pose.x, 3) << ", "
+      << Significant(r.pose.y, 3) << ") m";
+    if (r.estimate)
+      t << ", SLAM's estimate " << Significant(r.estimate_age_s, 2) << " s before it "
+        << Significant(std::hypot(r.estimate->x - r.pose.x, r.estimate->y - r.pose.y), 2) << " m off";
+    t << "\n";
+  }
   return t.str();
 }
 

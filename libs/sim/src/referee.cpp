@@ -144,6 +144,12 @@ void Referee::OnTruePose(int64_t t_us, const Pose2D& pose) {
   if (!stops_.empty()) JudgeStop(truth_.back());
 }
 
+void Referee::OnCollision(int64_t t_us, const Pose2D& pose) {
+  ++collisions_;
+  collision_at_.push_back({t_us, pose});
+  collision_estimate_.push_back(slam_.empty() ? std::nullopt : std::optional<TimedPose>(slam_.back()));
+}
+
 void Referee::OnSlamState(int64_t t_us, mapping::SlamState state) {
   if (state == mapping::SlamState::kLocalized && localized_us_ < 0) localized_us_ = t_us;
 }
@@ -214,6 +220,14 @@ Score Referee::Judge() const {
   // Where the map frame lies in the world: SLAM began at the origin at the start pose, or the map
   // was given in the world frame (the Warehouse).
   s.map_frame = warehouse ? Pose2D{} : s.start;
+  for (size_t i = 0; i < collision_at_.size(); ++i) {
+    CollisionRecord r{(collision_at_[i].first - t0_us_) * 1e-6, collision_at_[i].second, std::nullopt, 0.0};
+    if (const std::optional<TimedPose>& e = collision_estimate_[i]) {
+      r.estimate = s.map_frame.Compose(e->pose);
+      r.estimate_age_s = (collision_at_[i].first - e->t_us) * 1e-6;
+    }
+    s.collision_events.push_back(r);
+  }
   if (!slam_.empty()) {
     Pose2D truth_then;
     if (motion::InterpolateAt(truth_, slam_.back().t_us, 200'000, &truth_then)) {

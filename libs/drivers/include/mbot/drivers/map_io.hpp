@@ -55,8 +55,9 @@ void WriteMapPng(const msgs::OccupancyGrid& grid, const std::string& path);
 struct MapOverlay {
   std::vector<msgs::Pose2D> poses;
   uint8_t r = 0, g = 0, b = 0;
-  bool points = false;  // dots instead of a polyline
-  std::string label;    // shown in the legend when non-empty
+  bool points = false;      // dots instead of a polyline
+  std::string label;        // shown in the legend when non-empty
+  int point_radius_px = 1;  // points: a dot of this radius, or a ring above 2 pixels
 };
 
 // The map picture in colour, `scale` pixels per cell, with the overlays drawn in order and a legend.

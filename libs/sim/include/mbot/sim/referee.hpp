@@ -58,6 +58,16 @@ struct MapQuality {
   std::vector<motion::Pose2D> unmapped;  // centres of the reachable true cells not mapped free (map frame)
 };
 
+// A collision the simulator reported: when (since the start of the event), where the robot truly
+// was, and where SLAM placed it then (the map frame taken into the world), to tell a planning
+// fault (the estimate right, the path too close) from a localization one.
+struct CollisionRecord {
+  double t_s = 0;
+  motion::Pose2D pose;                     // true, world frame
+  std::optional<motion::Pose2D> estimate;  // SLAM's last pose before it, in the world frame
+  double estimate_age_s = 0;               // how long before the collision SLAM published it
+};
+
 struct StopResult {
   mission::warehouse::Stop stop;
   std::optional<double> done_at_s;  // since the start of the event
@@ -86,12 +96,13 @@ struct Score {
   double time_s = 0;  // to the mission's end, or the whole run
   double sim_s = 0;   // simulated time seen
   int collisions = 0;
-  motion::Pose2D start, final_pose;           // true, world frame
-  motion::Pose2D map_frame;                   // where the map frame lies in the world
-  std::optional<PoseError> final_error;       // final pose against the start (not the Warehouse)
-  std::optional<PoseError> slam_final_error;  // SLAM's last pose against the truth then
-  std::optional<MapQuality> map;              // not the Warehouse
-  std::optional<double> localized_at_s;       // the Warehouse: when global localization settled
+  std::vector<CollisionRecord> collision_events;  // each collision, in order
+  motion::Pose2D start, final_pose;               // true, world frame
+  motion::Pose2D map_frame;                       // where the map frame lies in the world
+  std::optional<PoseError> final_error;           // final pose against the start (not the Warehouse)
+  std::optional<PoseError> slam_final_error;      // SLAM's last pose against the truth then
+  std::optional<MapQuality> map;                  // not the Warehouse
+  std::optional<double> localized_at_s;           // the Warehouse: when global localization settled
   int levels_reached = 0;
   std::vector<StopResult> stops;
   std::vector<CrateResult> crates;  // Heavy Lift
@@ -123,7 +134,8 @@ class Referee {
   // Called first for every event of the stream, with its time.
   void Tick(int64_t t_us);
   void OnTruePose(int64_t t_us, const motion::Pose2D& pose);
-  void OnCollision() { ++collisions_; }
+  // A collision at the true pose `pose`.
+  void OnCollision(int64_t t_us, const motion::Pose2D& pose);
   void OnSlamPose(int64_t t_us, const motion::Pose2D& pose) { slam_.push_back({t_us, pose}); }
   void OnMap(std::shared_ptr<const mapping::OccupancyGrid> map) { map_ = std::move(map); }
   void OnSlamState(int64_t t_us, mapping::SlamState state);
@@ -154,6 +166,8 @@ class Referee {
   mission::MissionState state_ = mission::MissionState::kInitializing;
   std::string detail_;
   int collisions_ = 0;
+  std::vector<std::pair<int64_t, motion::Pose2D>> collision_at_;      // time and true pose of each
+  std::vector<std::optional<motion::TimedPose>> collision_estimate_;  // SLAM's pose then (map frame)
   bool stop_sent_ = false, timed_out_ = false;
   // Warehouse.
   std::vector<mission::warehouse::Stop> stops_;
