@@ -22,6 +22,10 @@ MotionControllerOptions ParseMotionControllerOptions(config::Section& s, const M
       s.GetDouble("final_tolerance_m", c.final_tolerance_m, "arrival tolerance at the last waypoint [m]", 0.001, 1.0);
   c.intermediate_tolerance_m = s.GetDouble("intermediate_tolerance_m", c.intermediate_tolerance_m,
                                            "an intermediate waypoint counts as passed this close [m]", 0.001, 2.0);
+  c.corner_tolerance_m = s.GetDouble("corner_tolerance_m", c.corner_tolerance_m,
+                                     "rotate_translate_rotate: the same at a waypoint where the path turns by more "
+                                     "than 45 degrees (a corner it stops at; 0: intermediate_tolerance_m) [m]",
+                                     0.0, 2.0);
   c.final_heading_tolerance_rad = s.GetDouble("final_heading_tolerance_rad", c.final_heading_tolerance_rad,
                                               "heading tolerance at the last waypoint [rad]", 0.001, 3.2);
   c.lookahead_m = s.GetDouble("lookahead_m", c.lookahead_m, "pure pursuit look-ahead [m]", 0.01, 5.0);
