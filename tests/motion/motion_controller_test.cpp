@@ -196,7 +196,7 @@ TEST(PurePursuitTest, TracksCurvedPathsCloserThanRotateTranslateRotate) {
 // Maze Explorer's robot touched wall ends it was driving round). corner_tolerance_m holds the
 // corners to their own radius and leaves gentler waypoints alone.
 TEST(RotateTranslateRotateTest, CornerToleranceHoldsSharpCornersOnly) {
-  const std::vector<Pose2D> hairpin = {{1.0, 0.0, 0}, {1.0, 0.4, 0}, {0.0, 0.4, M_PI}};
+  const std::vector<Pose2D> hairpin = {{0.5, 0.0, 0}, {1.0, 0.0, 0}, {1.0, 0.4, 0}, {0.0, 0.4, M_PI}};
   auto max_off = [&](double corner_tolerance_m, const std::vector<Pose2D>& path, Pose2D* end) {
     MotionControllerOptions o;
     o.corner_tolerance_m = corner_tolerance_m;

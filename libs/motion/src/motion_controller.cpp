@@ -80,7 +80,7 @@ VelocityCommand MotionController::Target(const Pose2D& pose) {
     if (options_.kind == ControllerKind::kPurePursuit) {
       if (PurePursuit(pose, &cmd)) return cmd;
     } else {
-      while (target_ < last && Dist(pose, waypoints_[target_]) < PassTolerance(target_, pose)) ++target_;
+      while (target_ < last && Dist(pose, waypoints_[target_]) < PassTolerance(target_)) ++target_;
       if (target_ < last || Dist(pose, waypoints_[last]) >= options_.final_tolerance_m) {
         return DriveTowards(pose, waypoints_[target_].x, waypoints_[target_].y, RtrStopDistance(pose));
       }
@@ -172,10 +172,12 @@ bool MotionController::PurePursuit(const Pose2D& pose, VelocityCommand* cmd) {
   return true;
 }
 
-double MotionController::PassTolerance(size_t k, const Pose2D& pose) const {
-  if (options_.corner_tolerance_m <= 0.0 || k + 1 >= waypoints_.size()) return options_.intermediate_tolerance_m;
-  // The leg into k: from the waypoint before it, or into the first from where the robot is now.
-  const Pose2D &a = k > 0 ? waypoints_[k - 1] : pose, &b = waypoints_[k], &c = waypoints_[k + 1];
+double MotionController::PassTolerance(size_t k) const {
+  // The first waypoint's leg is whatever the robot drives to it (a replanned path starts beside
+  // the robot, in any direction): only a corner between two of the path's legs is held.
+  if (options_.corner_tolerance_m <= 0.0 || k == 0 || k + 1 >= waypoints_.size())
+    return options_.intermediate_tolerance_m;
+  const Pose2D &a = waypoints_[k - 1], &b = waypoints_[k], &c = waypoints_[k + 1];
   if (Dist(a, b) == 0.0 || Dist(b, c) == 0.0) return options_.intermediate_tolerance_m;
   const double turn = WrapAngle(std::atan2(c.y - b.y, c.x - b.x) - std::atan2(b.y - a.y, b.x - a.x));
   return std::abs(turn) > options_.turn_in_place_rad ? options_.corner_tolerance_m : options_.intermediate_tolerance_m;

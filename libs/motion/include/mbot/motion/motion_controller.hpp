@@ -33,9 +33,9 @@ struct MotionControllerOptions {
   double max_angular_accel_rad_s2 = 6.0;
   double final_tolerance_m = 0.02;         // position tolerance at the last waypoint
   double intermediate_tolerance_m = 0.08;  // radius at which an intermediate waypoint counts as passed
-  // RTR: the same at a waypoint where the path turns by more than turn_in_place_rad (the robot stops
-  // and turns there). Heading on from short of such a corner cuts it by up to this much, towards
-  // whatever the path went round (0: intermediate_tolerance_m).
+  // RTR: the same at a waypoint after the first where the path turns by more than turn_in_place_rad
+  // (the robot stops and turns there). Heading on from short of such a corner cuts it by up to this
+  // much, towards whatever the path went round (0: intermediate_tolerance_m).
   double corner_tolerance_m = 0.0;
   double final_heading_tolerance_rad = 0.05;
   // Beyond this bearing error to the target the robot turns in place (v = 0) instead of driving an
@@ -86,9 +86,8 @@ class MotionController {
   bool PurePursuit(const Pose2D& pose, VelocityCommand* cmd);
   // Distance RTR can cover from `pose` before it must stop (final waypoint or a sharp turn).
   double RtrStopDistance(const Pose2D& pose) const;
-  // RTR: how near intermediate waypoint k must be passed (a sharp turn's corner, or any other), the
-  // robot being at `pose`.
-  double PassTolerance(size_t k, const Pose2D& pose) const;
+  // RTR: how near intermediate waypoint k must be passed (a sharp turn's corner, or any other).
+  double PassTolerance(size_t k) const;
   // Turn in place or drive towards `goal` (RTR law) with speed from `stop_distance_m`.
   VelocityCommand DriveTowards(const Pose2D& pose, double gx, double gy, double stop_distance_m) const;
   double Speed(double stop_distance_m) const;
