@@ -220,7 +220,7 @@ TEST(RotateTranslateRotateTest, CornerToleranceHoldsSharpCornersOnly) {
   EXPECT_GT(cut, 0.035);  // 4 cm on this exact unicycle; more on a robot whose turns lag
   EXPECT_LT(held, 0.5 * cut);
   EXPECT_LT(Dist(end, hairpin.back()), MotionControllerOptions{}.final_tolerance_m);
-  // Waypoints that turn by under 45 degrees each (a polygon of 12 round a circle) are driven as before.
+  // Waypoints that turn by under 45 degrees each (12 round a half circle, 15 degrees apart) are driven as before.
   std::vector<Pose2D> round;
   for (int k = 1; k <= 12; ++k) round.push_back({std::sin(k * M_PI / 12), 1 - std::cos(k * M_PI / 12), 0});
   Pose2D end_default, end_corner;

@@ -2,8 +2,8 @@
 // judge on the simulator. It feeds the referee the true poses, collisions and the stack's outputs,
 // ends the run when the referee says (the mission finished, or the time limit), and at the end
 // writes what the score holds: score.json, the trajectories (true, SLAM) as TUM, the final map
-// (.map + PNG with the planned, driven and true paths, warehouse stops), the printed rubric and the
-// competition's table row.
+// (.map + PNG with the planned, driven and true paths, warehouse stops, collisions), the printed
+// rubric and the competition's table row.
 #include <chrono>
 #include <cmath>
 #include <iostream>
