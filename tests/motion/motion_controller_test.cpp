@@ -215,9 +215,13 @@ TEST(RotateTranslateRotateTest, CornerToleranceHoldsSharpCornersOnly) {
   };
   Pose2D end;
   const double cut = max_off(0.0, hairpin, &end);
+  const double shipped = max_off(0.05, hairpin, &end);  // what maze_explorer.ini and live.ini set
+  EXPECT_LT(Dist(end, hairpin.back()), MotionControllerOptions{}.final_tolerance_m);
   const double held = max_off(0.02, hairpin, &end);
-  ::testing::Test::RecordProperty("hairpin_max_off_path_m", std::to_string(cut) + " -> " + std::to_string(held));
+  ::testing::Test::RecordProperty("hairpin_max_off_path_m", std::to_string(cut) + " -> " + std::to_string(shipped) +
+                                                                " (0.05) -> " + std::to_string(held) + " (0.02)");
   EXPECT_GT(cut, 0.035);  // 4 cm on this exact unicycle; more on a robot whose turns lag
+  EXPECT_LT(shipped, cut - 0.005);
   EXPECT_LT(held, 0.5 * cut);
   EXPECT_LT(Dist(end, hairpin.back()), MotionControllerOptions{}.final_tolerance_m);
   // Waypoints that turn by under 45 degrees each (12 round a half circle, 15 degrees apart) are driven as before.
@@ -227,6 +231,18 @@ TEST(RotateTranslateRotateTest, CornerToleranceHoldsSharpCornersOnly) {
   EXPECT_EQ(max_off(0.0, round, &end_default), max_off(0.02, round, &end_corner));
   EXPECT_EQ(end_default.x, end_corner.x);
   EXPECT_EQ(end_default.y, end_corner.y);
+}
+
+// A path's first waypoint is no corner of the path, however the robot stands to it (a replanned
+// path starts beside the robot): it keeps intermediate_tolerance_m, so one 6 cm away at a right
+// angle to the next leg is passed at once rather than circled back to.
+TEST(RotateTranslateRotateTest, TheFirstWaypointIsNoCorner) {
+  MotionControllerOptions o;
+  o.corner_tolerance_m = 0.02;
+  MotionController c(o);
+  c.SetPath({{0.06, 0.0, 0}, {0.06, 0.5, 0}, {0.06, 1.0, M_PI / 2}});
+  c.Update({0, 0, 0}, kDt);
+  EXPECT_EQ(c.progress().waypoint_index, 1u);
 }
 
 TEST(MotionControllerTest, TurnsInPlaceTowardsAWaypointBehind) {

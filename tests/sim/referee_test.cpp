@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace mbot::sim {
 namespace {
 
@@ -125,7 +127,8 @@ TEST(RefereeSpeedRun, ScoresAPerfectLapAndEndsAfterTheMission) {
 }
 
 // Each collision is kept with its time since the start, the true pose and SLAM's last estimate
-// before it, taken from the map frame (the start) into the world.
+// before it, taken from the map frame (the start) into the world, and scored against the truth at
+// the estimate's own time (the robot drove on before it touched).
 TEST(RefereeCollisions, EachIsKeptWithItsTimePoseAndTheEstimateThen) {
   const World world = World::Load(std::string(MBOT_SOURCE_DIR) + "/datasets/arenas/convex_circuit.arena");
   Referee r({CompetitionEvent::kMazeExplorer, 120.0, 0.5}, world, 1);
@@ -134,21 +137,25 @@ TEST(RefereeCollisions, EachIsKeptWithItsTimePoseAndTheEstimateThen) {
   r.OnTruePose(1'000'000, start);
   r.Tick(2'000'000);
   r.OnCollision(2'000'000, {1.0, 0.4, M_PI});  // before SLAM published: no estimate
-  r.OnSlamPose(2'500'000, {0.3, 0.0, 0.0});    // 0.3 m ahead of the start, in the start's frame
+  r.OnTruePose(2'400'000, {1.0, 0.82, M_PI / 2});
+  r.OnTruePose(2'600'000, {1.0, 0.84, M_PI / 2});  // the truth at 2.5 s: (1, 0.83)
+  r.OnSlamPose(2'500'000, {0.3, 0.0, 0.0});        // 0.3 m ahead of the start, in the start's frame
   r.Tick(3'000'000);
-  r.OnTruePose(3'000'000, {1.0, 0.82, M_PI / 2});
-  r.OnCollision(3'000'000, {1.0, 0.82, M_PI / 2});
+  r.OnTruePose(3'000'000, {1.0, 0.9, M_PI / 2});
+  r.OnCollision(3'000'000, {1.0, 0.9, M_PI / 2});
   const Score s = r.Judge();
   EXPECT_EQ(s.collisions, 2);
   ASSERT_EQ(s.collision_events.size(), 2u);
   EXPECT_DOUBLE_EQ(s.collision_events[0].t_s, 1.0);
   EXPECT_DOUBLE_EQ(s.collision_events[0].pose.theta, M_PI);
   EXPECT_FALSE(s.collision_events[0].estimate);
+  EXPECT_TRUE(std::isnan(s.collision_events[0].estimate_error_m));
   EXPECT_DOUBLE_EQ(s.collision_events[1].t_s, 2.0);
   ASSERT_TRUE(s.collision_events[1].estimate);
   EXPECT_NEAR(s.collision_events[1].estimate->x, 1.0, 1e-12);  // ahead of the start is +y in the world
   EXPECT_NEAR(s.collision_events[1].estimate->y, 0.8, 1e-12);
   EXPECT_DOUBLE_EQ(s.collision_events[1].estimate_age_s, 0.5);
+  EXPECT_NEAR(s.collision_events[1].estimate_error_m, 0.03, 1e-9);  // not 0.1, the distance to the collision
 }
 
 }  // namespace

@@ -42,7 +42,7 @@ Json ScoreReport(const sim::Score& s, const ScoreContext& c) {
     Json h = {{"t_s", Number(r.t_s)}, {"pose", PoseJson(r.pose)}};
     if (r.estimate) {
       h["estimate"] = PoseJson(*r.estimate);
-      h["estimate_error_m"] = Number(std::hypot(r.estimate->x - r.pose.x, r.estimate->y - r.pose.y));
+      h["estimate_error_m"] = Number(r.estimate_error_m);  // null without the truth at its time
       h["estimate_age_s"] = Number(r.estimate_age_s);
     }
     hits.push_back(std::move(h));
@@ -109,7 +109,7 @@ std::string RubricText(const sim::Score& s, const ScoreContext& c) {
       << Significant(r.pose.y, 3) << ") m";
     if (r.estimate)
       t << ", SLAM's estimate " << Significant(r.estimate_age_s, 2) << " s before it "
-        << Significant(std::hypot(r.estimate->x - r.pose.x, r.estimate->y - r.pose.y), 2) << " m off";
+        << Significant(r.estimate_error_m, 2) << " m off the truth then";
     t << "\n";
   }
   return t.str();

@@ -225,6 +225,10 @@ Score Referee::Judge() const {
     if (const std::optional<TimedPose>& e = collision_estimate_[i]) {
       r.estimate = s.map_frame.Compose(e->pose);
       r.estimate_age_s = (collision_at_[i].first - e->t_us) * 1e-6;
+      // Its error against the truth at its own time, not at the collision's: the robot moved between.
+      Pose2D truth_then;
+      if (motion::InterpolateAt(truth_, e->t_us, 200'000, &truth_then))
+        r.estimate_error_m = std::hypot(r.estimate->x - truth_then.x, r.estimate->y - truth_then.y);
     }
     s.collision_events.push_back(r);
   }

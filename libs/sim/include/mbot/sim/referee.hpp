@@ -9,6 +9,7 @@
 // the simulator's crates). Times are microseconds on the simulation's clock.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -66,6 +67,8 @@ struct CollisionRecord {
   motion::Pose2D pose;                     // true, world frame
   std::optional<motion::Pose2D> estimate;  // SLAM's last pose before it, in the world frame
   double estimate_age_s = 0;               // how long before the collision SLAM published it
+  // The estimate's distance from the true pose at the estimate's own time (NaN: no truth then).
+  double estimate_error_m = NAN;
 };
 
 struct StopResult {
