@@ -131,9 +131,7 @@ struct CrossTrack {
   Pose2D end;
 };
 
-CrossTrack FollowCurve(ControllerKind kind, const std::vector<Pose2D>& path, const Pose2D& start) {
-  MotionControllerOptions o;
-  o.kind = kind;
+CrossTrack FollowCurve(const MotionControllerOptions& o, const std::vector<Pose2D>& path, const Pose2D& start) {
   MotionController c(o);
   c.SetPath(path);
   std::vector<Pose2D> poses;
@@ -167,8 +165,11 @@ TEST(PurePursuitTest, TracksCurvedPathsCloserThanRotateTranslateRotate) {
   const MotionControllerOptions o;
   for (size_t n : {size_t{60}, s_curve.size()}) {  // the quarter circle alone, then the S
     const std::vector<Pose2D> path(s_curve.begin(), s_curve.begin() + n);
-    const CrossTrack pp = FollowCurve(ControllerKind::kPurePursuit, path, start);
-    const CrossTrack rtr = FollowCurve(ControllerKind::kRotateTranslateRotate, path, start);
+    MotionControllerOptions pp_options, rtr_options;
+    pp_options.kind = ControllerKind::kPurePursuit;
+    rtr_options.kind = ControllerKind::kRotateTranslateRotate;
+    const CrossTrack pp = FollowCurve(pp_options, path, start);
+    const CrossTrack rtr = FollowCurve(rtr_options, path, start);
     ASSERT_TRUE(pp.arrived);
     ASSERT_TRUE(rtr.arrived);
     for (const CrossTrack* r : {&pp, &rtr}) {
@@ -197,21 +198,13 @@ TEST(PurePursuitTest, TracksCurvedPathsCloserThanRotateTranslateRotate) {
 // corners to their own radius and leaves gentler waypoints alone.
 TEST(RotateTranslateRotateTest, CornerToleranceHoldsSharpCornersOnly) {
   const std::vector<Pose2D> hairpin = {{0.5, 0.0, 0}, {1.0, 0.0, 0}, {1.0, 0.4, 0}, {0.0, 0.4, M_PI}};
-  auto max_off = [&](double corner_tolerance_m, const std::vector<Pose2D>& path, Pose2D* end) {
+  auto max_off = [](double corner_tolerance_m, const std::vector<Pose2D>& path, Pose2D* end) {
     MotionControllerOptions o;
     o.corner_tolerance_m = corner_tolerance_m;
-    MotionController c(o);
-    c.SetPath(path);
-    std::vector<Pose2D> poses;
-    std::vector<VelocityCommand> cmds;
-    *end = Drive(c, {0, 0, 0}, 30.0, &cmds, &poses);
-    EXPECT_TRUE(c.arrived());
-    ExpectWithinLimits(cmds, o);
-    std::vector<Pose2D> line = {{0, 0, 0}};
-    line.insert(line.end(), path.begin(), path.end());
-    double worst = 0;
-    for (const Pose2D& p : poses) worst = std::max(worst, DistanceToPolyline(p, line));
-    return worst;
+    const CrossTrack r = FollowCurve(o, path, {0, 0, 0});
+    EXPECT_TRUE(r.arrived);
+    *end = r.end;
+    return r.max;
   };
   Pose2D end;
   const double cut = max_off(0.0, hairpin, &end);

@@ -145,9 +145,7 @@ void Referee::OnTruePose(int64_t t_us, const Pose2D& pose) {
 }
 
 void Referee::OnCollision(int64_t t_us, const Pose2D& pose) {
-  ++collisions_;
-  collision_at_.push_back({t_us, pose});
-  collision_estimate_.push_back(slam_.empty() ? std::nullopt : std::optional<TimedPose>(slam_.back()));
+  collisions_.push_back({{t_us, pose}, slam_.empty() ? std::nullopt : std::optional<TimedPose>(slam_.back())});
 }
 
 void Referee::OnSlamState(int64_t t_us, mapping::SlamState state) {
@@ -208,7 +206,7 @@ Score Referee::Judge() const {
   s.event = o_.event;
   s.state = state_, s.detail = detail_;
   s.timed_out = timed_out_;
-  s.collisions = collisions_;
+  s.collisions = static_cast<int>(collisions_.size());
   s.sim_s = t0_us_ >= 0 ? (last_us_ - t0_us_) * 1e-6 : 0.0;
   s.completed = state_ == mission::MissionState::kCompleted;
   s.incomplete = state_ == mission::MissionState::kIncomplete;
@@ -220,11 +218,11 @@ Score Referee::Judge() const {
   // Where the map frame lies in the world: SLAM began at the origin at the start pose, or the map
   // was given in the world frame (the Warehouse).
   s.map_frame = warehouse ? Pose2D{} : s.start;
-  for (size_t i = 0; i < collision_at_.size(); ++i) {
-    CollisionRecord r{(collision_at_[i].first - t0_us_) * 1e-6, collision_at_[i].second, std::nullopt, 0.0};
-    if (const std::optional<TimedPose>& e = collision_estimate_[i]) {
+  for (const Collision& c : collisions_) {
+    CollisionRecord r{(c.truth.t_us - t0_us_) * 1e-6, c.truth.pose, std::nullopt, 0.0};
+    if (const std::optional<TimedPose>& e = c.estimate) {
       r.estimate = s.map_frame.Compose(e->pose);
-      r.estimate_age_s = (collision_at_[i].first - e->t_us) * 1e-6;
+      r.estimate_age_s = (c.truth.t_us - e->t_us) * 1e-6;
       // Its error against the truth at its own time, not at the collision's: the robot moved between.
       Pose2D truth_then;
       if (motion::InterpolateAt(truth_, e->t_us, 200'000, &truth_then))

@@ -168,9 +168,11 @@ class Referee {
   std::shared_ptr<const mapping::OccupancyGrid> map_;
   mission::MissionState state_ = mission::MissionState::kInitializing;
   std::string detail_;
-  int collisions_ = 0;
-  std::vector<std::pair<int64_t, motion::Pose2D>> collision_at_;      // time and true pose of each
-  std::vector<std::optional<motion::TimedPose>> collision_estimate_;  // SLAM's pose then (map frame)
+  struct Collision {
+    motion::TimedPose truth;                    // when and where it happened
+    std::optional<motion::TimedPose> estimate;  // SLAM's last pose before it (map frame)
+  };
+  std::vector<Collision> collisions_;
   bool stop_sent_ = false, timed_out_ = false;
   // Warehouse.
   std::vector<mission::warehouse::Stop> stops_;
